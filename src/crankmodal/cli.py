@@ -1,0 +1,116 @@
+"""Command line: ``crankmodal run | check | demo | machines``.
+
+User errors (:class:`~crankmodal.errors.CrankmodalError`) print one line on stderr and exit with
+status 2 (3 for a failed numerical check), without a traceback unless ``--debug`` is given.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from . import __version__
+from .errors import CrankmodalError
+
+DEMO_SCENE = "four_star_compressor"
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # argparse's usage errors: one line, exit 2
+        raise CrankmodalError(f"usage: {message} (see crankmodal --help)")
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="crankmodal", description=__doc__.splitlines()[0])
+    p.add_argument("--version", action="version", version=f"crankmodal {__version__}")
+    p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    def scene_args(sp, scene_required=True):
+        if scene_required:
+            sp.add_argument("scene", help="scene TOML file")
+        sp.add_argument(
+            "--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
+            help="override a scene value (TOML syntax; repeatable)",
+        )
+
+    r = sub.add_parser("run", help="run a scene, write DIR/results.json and figures")
+    scene_args(r)
+    r.add_argument("--out", type=Path, help="output folder (default out/<scene name>)")
+    r.add_argument("--no-figures", action="store_true", help="skip PNG plots")
+
+    c = sub.add_parser("check", help="validate a scene without running it")
+    scene_args(c)
+
+    d = sub.add_parser("demo", help="run the main job: the four-star compressor study")
+    scene_args(d, scene_required=False)
+    d.add_argument("--out", type=Path, help="output folder (default out/four_star_compressor)")
+    d.add_argument("--no-figures", action="store_true", help="skip PNG plots")
+
+    sub.add_parser("machines", help="list the machine parameter files")
+    return p
+
+
+def _summary(results: dict) -> str:
+    """A few lines a person reads after a run: per stage, its headline numbers."""
+    lines = [f"crankmodal {results['crankmodal_version']}  scene {results['scene']}"]
+    for section, res in results.items():
+        if not isinstance(res, dict):
+            continue
+        head = res.get("summary")
+        t = res.get("wall_time_s", 0.0)
+        lines.append(f"  [{section}] {t:.2f} s" + (f"  {head}" if head else ""))
+    return "\n".join(lines)
+
+
+def _run(scene_file: Path, overrides, out: Path | None, figures: bool) -> int:
+    from .runner import run
+    from .scene import load_scene
+
+    scene = load_scene(scene_file, overrides)
+    out_dir = out if out is not None else Path("out") / scene.name
+    results = run(scene, out_dir, figures=figures, log=lambda s: print(s, file=sys.stderr))
+    print(_summary(results))
+    print(f"results: {out_dir / 'results.json'}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``crankmodal`` console script; returns the exit status."""
+    argv = sys.argv[1:] if argv is None else argv
+    debug = "--debug" in argv
+    try:
+        args = _parser().parse_args(argv)
+        if args.command == "run":
+            return _run(args.scene, args.overrides, args.out, not args.no_figures)
+        if args.command == "demo":
+            from .resources import scene_path
+
+            return _run(scene_path(DEMO_SCENE), args.overrides, args.out, not args.no_figures)
+        if args.command == "check":
+            from .runner import check
+            from .scene import load_scene
+
+            scene = load_scene(args.scene, args.overrides)
+            sections = check(scene)
+            print(f"{args.scene}: ok ({', '.join(sections)})")
+            return 0
+        if args.command == "machines":
+            from .resources import list_machines
+
+            print("\n".join(list_machines()))
+            return 0
+    except CrankmodalError as exc:
+        if debug:
+            raise
+        print(f"crankmodal: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("crankmodal: interrupted", file=sys.stderr)
+        return 130
+    return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,30 @@
+"""User-facing errors.
+
+Anything a user can cause (a bad scene value, a missing file, impossible geometry) raises a
+subclass of :class:`CrankmodalError`. The CLI turns it into one line on stderr and exit status 2
+(3 for :class:`NumericalError`), never a traceback.
+"""
+
+
+class CrankmodalError(Exception):
+    """Base class of the errors a user can fix; the message names the offending value."""
+
+    exit_code = 2
+
+
+class SceneError(CrankmodalError):
+    """A scene key is unknown, of the wrong type, or out of its admissible range."""
+
+
+class InputFileError(CrankmodalError):
+    """A file named in a scene is missing or unreadable."""
+
+
+class GeometryError(CrankmodalError):
+    """A parameter set describes an impossible part, or the geometry kernel failed on it."""
+
+
+class NumericalError(CrankmodalError):
+    """A computation did not meet its own accuracy checks; the message says what to change."""
+
+    exit_code = 3

@@ -1,0 +1,130 @@
+"""The scene runner: validate every section, run only the stages asked for, write results.
+
+Each stage is a module ``crankmodal.<pkg>.stage`` that imports nothing heavy at module level and
+provides
+
+``SECTION``
+    the scene section it owns;
+``REQUIRES``
+    sections whose products it needs (they must be present in the scene);
+``validate(raw: dict, scene: Scene) -> dict``
+    checks the raw table, returns parameters (raises SceneError);
+``run(params: dict, ctx: StageContext) -> dict``
+    computes, writes its figures/arrays into ``ctx.out_dir``, stores any object later stages
+    need in ``ctx.products[SECTION]``, and returns its JSON-able results.
+
+Stage modules are imported only when their section is present, so a ``[mechanism]`` scene never
+loads gmsh, scikit-fem or pyvista.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import __version__
+from .errors import SceneError
+from .results import write_json_atomic
+from .scene import Scene
+
+#: section -> stage module, in data-flow order (a stage runs after everything above it).
+STAGES: dict[str, str] = {
+    "geometry": "crankmodal.geometry.stage",
+    "material": "crankmodal.fem.material_stage",
+    "modal": "crankmodal.fem.modal_stage",
+    "static": "crankmodal.fem.static_stage",
+    "reduction": "crankmodal.reduction.stage",
+    "torsion": "crankmodal.torsion.stage",
+    "mechanism": "crankmodal.mechanism.stage",
+    "dynamics": "crankmodal.dynamics.stage",
+    "report": "crankmodal.report.stage",
+}
+
+
+@dataclass
+class StageContext:
+    """What a running stage sees: the scene, where to write, and earlier stages' products."""
+
+    scene: Scene
+    out_dir: Path
+    products: dict = field(default_factory=dict)
+    params: dict = field(default_factory=dict)
+    results: dict = field(default_factory=dict)
+    figures: bool = True
+
+
+def stage_module(section: str):
+    """Import the stage module owning ``section``."""
+    if section not in STAGES:
+        allowed = ", ".join(STAGES)
+        raise SceneError(f"[{section}]: unknown section; allowed sections are: {allowed}")
+    try:
+        return importlib.import_module(STAGES[section])
+    except ModuleNotFoundError as exc:
+        if exc.name and exc.name.startswith("crankmodal"):
+            raise SceneError(
+                f"[{section}]: this stage is not available in crankmodal {__version__} yet"
+            ) from None
+        raise
+
+
+def plan(scene: Scene) -> list[str]:
+    """Sections of the scene in run order, with their prerequisites checked."""
+    order = [s for s in STAGES if s in scene.sections]
+    for s in scene.sections:
+        if s not in STAGES:
+            stage_module(s)  # raises the unknown-section error
+    if not order:
+        raise SceneError(f"scene {scene.name!r} has no sections; allowed: {', '.join(STAGES)}")
+    for s in order:
+        for need in getattr(stage_module(s), "REQUIRES", ()):
+            if need not in scene.sections:
+                raise SceneError(f"[{s}] needs a [{need}] section in the scene")
+    return order
+
+
+def check(scene: Scene) -> dict[str, dict]:
+    """Validate every section without running anything; returns the parameters per section."""
+    return {s: stage_module(s).validate(scene.sections[s], scene) for s in plan(scene)}
+
+
+def run(scene: Scene, out_dir: str | Path, figures: bool = True, log=None) -> dict:
+    """Run a scene and write ``out_dir/results.json`` atomically.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene to run.
+    out_dir : str or Path
+        Output folder (created). A stale ``results.json`` there is removed once the scene has
+        validated, so a failed run never leaves an old result looking new.
+    figures : bool
+        Write PNG plots.
+    log : callable, optional
+        ``log(str)`` for progress lines.
+
+    Returns
+    -------
+    dict
+        The results as written.
+    """
+    params = check(scene)
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "results.json").unlink(missing_ok=True)
+    ctx = StageContext(scene=scene, out_dir=out_dir, params=params, figures=figures)
+    results: dict = {"crankmodal_version": __version__, "scene": scene.name}
+    ctx.results = results
+    for section, p in params.items():
+        if log:
+            log(f"[{section}] running")
+        t0 = time.perf_counter()
+        res = stage_module(section).run(p, ctx) or {}
+        res["wall_time_s"] = time.perf_counter() - t0
+        results[section] = res
+        if log:
+            log(f"[{section}] done in {res['wall_time_s']:.2f} s")
+    write_json_atomic(out_dir / "results.json", results)
+    return results

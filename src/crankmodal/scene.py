@@ -1,0 +1,149 @@
+"""Scenes: TOML files whose sections say what to compute.
+
+A scene is read with :mod:`tomllib`, ``--set section.key=value`` overrides are applied, and every
+section that names a ``machine`` gets that machine's table of the same name (from ``geometry/``)
+as defaults underneath its own values. Stage-specific checking is done by each stage's
+``validate`` (see :mod:`crankmodal.runner`).
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import SceneError
+from .resources import load_machine, load_toml
+
+#: Top-level scalar keys a scene may carry besides its sections.
+TOP_LEVEL_KEYS = ("name", "description")
+
+
+@dataclass
+class Scene:
+    """A parsed scene.
+
+    Attributes
+    ----------
+    name : str
+        Scene name (``name`` key, else the file stem); names the default output folder.
+    base_dir : Path
+        Folder against which relative file names in the scene are resolved.
+    sections : dict
+        Raw section tables, after overrides and machine defaults; not yet validated.
+    path : Path or None
+        The scene file, if read from one.
+    description : str
+        Free text.
+    """
+
+    name: str
+    base_dir: Path
+    sections: dict[str, dict] = field(default_factory=dict)
+    path: Path | None = None
+    description: str = ""
+
+    def resolve(self, filename: str) -> Path:
+        """A file name from the scene, relative to the scene's folder."""
+        p = Path(filename).expanduser()
+        return p if p.is_absolute() else (self.base_dir / p)
+
+
+def deep_merge(base: dict, over: dict) -> dict:
+    """``over`` on top of ``base``; nested tables merge, everything else is replaced."""
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = deep_merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def parse_value(text: str) -> Any:
+    """A ``--set`` value: TOML syntax if it parses (``1480``, ``[1, 2]``, ``true``), else a string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_override(tables: dict, assignment: str) -> None:
+    """Apply one ``section.key[.sub]=value`` assignment in place."""
+    if "=" not in assignment:
+        raise SceneError(f"--set {assignment!r}: expected section.key=value")
+    dotted, _, text = assignment.partition("=")
+    parts = [p.strip() for p in dotted.strip().split(".")]
+    if len(parts) < 2 or not all(parts):
+        raise SceneError(f"--set {assignment!r}: expected section.key=value")
+    node = tables
+    for p in parts[:-1]:
+        nxt = node.setdefault(p, {})
+        if not isinstance(nxt, dict):
+            raise SceneError(f"--set {dotted}: {p!r} is not a table")
+        node = nxt
+    node[parts[-1]] = parse_value(text.strip())
+
+
+def scene_from_dict(
+    data: dict,
+    name: str = "scene",
+    base_dir: Path | str = ".",
+    overrides: list[str] | tuple[str, ...] = (),
+    path: Path | None = None,
+) -> Scene:
+    """Build a :class:`Scene` from a TOML-like dict (the programmatic entry point)."""
+    data = copy.deepcopy(data)
+    for assignment in overrides:
+        apply_override(data, assignment)
+    sections = {}
+    for key, value in data.items():
+        if key in TOP_LEVEL_KEYS:
+            if not isinstance(value, str):
+                raise SceneError(f"{key}: must be a string, got {value!r}")
+            continue
+        if not isinstance(value, dict):
+            raise SceneError(
+                f"{key}: unknown top-level key; a scene holds {', '.join(TOP_LEVEL_KEYS)} and sections"
+            )
+        sections[key] = with_machine_defaults(key, value)
+    return Scene(
+        name=data.get("name", name),
+        base_dir=Path(base_dir),
+        sections=sections,
+        path=path,
+        description=data.get("description", ""),
+    )
+
+
+def with_machine_defaults(section: str, table: dict) -> dict:
+    """Underlay the machine's table named like the section, when the section names a machine."""
+    machine = table.get("machine")
+    if machine is None:
+        return table
+    if not isinstance(machine, str):
+        raise SceneError(f"{section}.machine: must be a string, got {machine!r}")
+    tables = load_machine(machine)
+    defaults = tables.get(section)
+    if defaults is None:
+        return table
+    return deep_merge(defaults, table)
+
+
+def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Scene:
+    """Read a scene file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML scene.
+    overrides : sequence of str
+        ``section.key=value`` assignments applied before validation.
+    """
+    path = Path(path)
+    data = load_toml(path)
+    return scene_from_dict(
+        data, name=path.stem, base_dir=path.resolve().parent, overrides=overrides, path=path
+    )
