@@ -1,0 +1,25 @@
+"""Shared fixtures: the repository paths and a helper that runs the CLI in a subprocess."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+SCENES = REPO / "scenes"
+
+
+def run_cli(*args, cwd=None, timeout=600):
+    """Run ``python -m crankmodal.cli ARGS``; returns the CompletedProcess (text mode)."""
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONWARNINGS="ignore")
+    return subprocess.run(
+        [sys.executable, "-m", "crankmodal.cli", *map(str, args)],
+        cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout,
+    )
+
+
+@pytest.fixture
+def cli():
+    return run_cli
