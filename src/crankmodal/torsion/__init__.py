@@ -1,0 +1,37 @@
+"""Torsional checks of crankshafts the way design offices do them beside FE.
+
+Modules, one concept each:
+
+- :mod:`.equivalent_length` -- Ker Wilson / Carter equivalent length of a crank throw, shaft
+  segments in series, stiffness ``k = G J / L``;
+- :mod:`.inertias` -- throw and flywheel mass moments of inertia (seed 004 eqs. 2-5) and the
+  inertia about the shaft axis of a CAD solid;
+- :mod:`.mesh_inertias` -- the same rotor inertias integrated over a tetrahedral mesh of the part;
+- :mod:`.crank_model` -- a chain of throws and a flywheel from crank dimensions;
+- :mod:`.chain` -- the lumped torsional chain and its exact eigen solution;
+- :mod:`.two_rotor` -- closed-form two-rotor frequency and node, and the reduction of a chain
+  to two rotors;
+- :mod:`.holzer` -- the Holzer method (residual torque sweep, bracketed roots, Holzer table);
+- :mod:`.critical_speeds` -- orders x running speed against natural frequencies;
+- :mod:`.fe_compare` -- picking the torsional mode out of FE results and the side-by-side table;
+- :mod:`.plots` -- PNG figures (matplotlib imported inside the functions);
+- :mod:`.stage` -- the ``[torsion]`` scene section.
+
+Only numpy and scipy are imported here; nothing pulls in gmsh, scikit-fem or pyvista.
+"""
+
+from .chain import ChainModes, TorsionalChain, exact_modes
+from .holzer import HolzerResult, holzer, holzer_table
+from .two_rotor import TwoRotorResult, reduce_to_two_rotors, two_rotor
+
+__all__ = [
+    "ChainModes",
+    "HolzerResult",
+    "TorsionalChain",
+    "TwoRotorResult",
+    "exact_modes",
+    "holzer",
+    "holzer_table",
+    "reduce_to_two_rotors",
+    "two_rotor",
+]
