@@ -1,0 +1,121 @@
+"""Running a mechanism: simulate with checks, and the error-against-run-time study."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..errors import NumericalError
+from .history import History, record
+from .signals import order_amplitudes
+from .simulate import SolverSettings, integrate
+
+
+def output_times(t_end: float, output_step: float) -> np.ndarray:
+    """Uniform output times ``0, dt, ..., t_end`` (s)."""
+    k = round(t_end / output_step)
+    return np.linspace(0.0, k * output_step, k + 1)
+
+
+def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, ideal=False,
+             energy_tolerance: float | None = 1e-3) -> History:
+    """Integrate a mechanism and sample its history.
+
+    Parameters
+    ----------
+    mech : Mechanism
+    t_end, output_step : float
+        s.
+    settings : SolverSettings, optional
+    ideal : bool
+        Run the ideal-joint twin instead of the clearance model.
+    energy_tolerance : float or None
+        Largest admissible energy-balance residual relative to the largest energy term.
+
+    Raises
+    ------
+    NumericalError
+        Solver failure, or an energy balance that does not close, or a penetration so deep the
+        contact law is meaningless (the message names the parameter to change).
+    """
+    settings = settings or SolverSettings()
+    sysm = mech.ideal if ideal else mech.system
+    for cj in sysm.clearances:
+        cj.v_impact = cj.v_impact_min
+    integ = integrate(sysm, mech.q0, mech.qd0, t_end, output_times(t_end, output_step), settings)
+    hist = record(mech, sysm, integ)
+    hist.nfev, hist.wall_time = integ.nfev, integ.wall_time
+    for cj in sysm.clearances:
+        depth = float(np.max(hist.contact[cj.name]["penetration"], initial=0.0))
+        if depth > 0.1 * cj.journal_radius:
+            raise NumericalError(
+                f"clearance joint {cj.name!r}: penetration {depth:.3g} m exceeds 10 % of the "
+                f"journal radius: contact.stiffness = {cj.law_params.get('stiffness'):.3g} is "
+                "too low for these loads; raise it")
+    err = hist.energy_error()
+    if energy_tolerance is not None and err > energy_tolerance:
+        raise NumericalError(
+            f"energy balance does not close: residual {err:.2e} of the largest energy term "
+            f"(tolerance {energy_tolerance:g}); tighten solver.rtol/solver.atol or lower "
+            "solver.max_step_deg")
+    return hist
+
+
+def key_outputs(hist: History, revolution_hz: float, t_start: float, orders=(1, 2, 3, 4)) -> dict:
+    """The quantities a tolerance study compares: peaks and main-bearing order amplitudes."""
+    sel = hist.t >= t_start
+    fn = max((float(np.max(c["fn"][sel], initial=0.0)) for c in hist.contact.values()),
+             default=0.0)
+    acc = float(np.max(np.abs(hist.piston_acceleration[sel]), initial=0.0))
+    t = hist.t[sel]
+    n_rev = int(np.floor((t[-1] - t[0]) * revolution_hz + 1e-9)) if t.size > 1 else 0
+    if n_rev >= 1:
+        keep = t <= t[0] + n_rev / revolution_hz + 1e-12
+        amps = order_amplitudes(t[keep], hist.main_bearing_force[sel][keep], revolution_hz, orders)
+        rms = np.sqrt(0.5 * np.sum(amps**2, axis=1))
+    else:
+        rms = np.full(len(orders), np.nan)
+    return {"peak_contact_force": fn, "peak_piston_acceleration": acc,
+            "main_bearing_order_rms": rms}
+
+
+def tolerance_study(mech, t_end, output_step, rtols, t_start=0.0, base=None) -> dict:
+    """The same run at a sequence of tolerances: key outputs against wall time.
+
+    Differences are taken against the tightest tolerance. Returns lists per rtol.
+    """
+    base = base or SolverSettings()
+    rows = []
+    for rtol in sorted(rtols, reverse=True):
+        s = SolverSettings(method=base.method, rtol=rtol, atol=base.atol * rtol / base.rtol,
+                           velocity_scale=base.velocity_scale, max_step=base.max_step,
+                           max_rhs_evals=base.max_rhs_evals)
+        t0 = time.perf_counter()
+        h = simulate(mech, t_end, output_step, s, energy_tolerance=None)
+        wall = time.perf_counter() - t0
+        rows.append((rtol, wall, h.nfev, key_outputs(h, mech.revolution_hz, t_start),
+                     h.energy_error()))
+    ref = rows[-1][3]
+    out = {"rtol": [], "wall_time_s": [], "rhs_evals": [], "energy_error": [],
+           "peak_contact_force": [], "peak_piston_acceleration": [],
+           "d_peak_contact_force": [], "d_peak_piston_acceleration": [],
+           "d_main_bearing_order_rms": []}
+    for rtol, wall, nfev, k, e in rows:
+        out["rtol"].append(rtol)
+        out["wall_time_s"].append(wall)
+        out["rhs_evals"].append(nfev)
+        out["energy_error"].append(e)
+        out["peak_contact_force"].append(k["peak_contact_force"])
+        out["peak_piston_acceleration"].append(k["peak_piston_acceleration"])
+        out["d_peak_contact_force"].append(_rel(k["peak_contact_force"], ref["peak_contact_force"]))
+        out["d_peak_piston_acceleration"].append(
+            _rel(k["peak_piston_acceleration"], ref["peak_piston_acceleration"]))
+        d = np.abs(k["main_bearing_order_rms"] - ref["main_bearing_order_rms"])
+        scale = np.maximum(np.abs(ref["main_bearing_order_rms"]), 1e-300)
+        out["d_main_bearing_order_rms"].append(float(np.nan_to_num(np.max(d / scale), nan=0.0)))
+    return out
+
+
+def _rel(a, b):
+    return abs(a - b) / abs(b) if b else abs(a - b)

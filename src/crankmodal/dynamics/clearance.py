@@ -1,0 +1,173 @@
+"""The clearance revolute joint: a journal moving freely inside a bearing bore.
+
+The joint sees two interface frames only: the journal centre (on one body) and the bearing
+centre (on another). With eccentricity vector ``e = p_journal - p_bearing`` the penetration is
+``delta = |e| - c`` (``c`` the radial clearance); in contact a normal force pushes the journal
+back towards the bearing centre and a friction force acts along the surfaces against their
+relative slip. Free flight, impact and continuous contact all follow from the same force law.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import contact
+from .lubrication import short_bearing_force
+
+
+@dataclass
+class ClearanceJoint:
+    """A revolute joint with radial clearance.
+
+    Parameters
+    ----------
+    name : str
+        Joint name (outputs).
+    journal, journal_frame : body, str
+        The body carrying the pin and the frame at the pin centre.
+    bearing, bearing_frame : body, str
+        The body carrying the bore and the frame at the bore centre.
+    clearance : float
+        Radial clearance ``c = R_bearing - R_journal``, m.
+    journal_radius : float
+        m (lever arm of friction).
+    law : str
+        Normal force law, one of :data:`contact.NORMAL_LAWS`.
+    law_params : dict
+        Parameters of the law (see :func:`contact.normal_force`).
+    friction : str
+        One of :data:`contact.FRICTION_LAWS`.
+    friction_params : dict
+        ``mu_static, mu_dynamic, v_static, v_dynamic`` (m/s).
+    v_impact_min : float
+        Floor of the impact velocity used by restitution laws, m/s: a contact that starts at
+        (almost) zero approach speed would otherwise get unbounded damping.
+    clearance_major : float or None
+        Radial clearance along the major axis of a worn (elliptical) bore, m (>= clearance,
+        which is then the minor-axis clearance); None for a round bore.
+    wear_angle : float
+        Direction of the major axis in the bearing body's frame, rad.
+    viscosity : float or None
+        Lubricant dynamic viscosity, Pa s: adds the short-bearing film force of
+        :mod:`.lubrication` (round bores only); None for a dry joint.
+    bearing_length : float
+        Bearing length for the film force, m.
+    eps_max : float
+        Eccentricity ratio at which the film force stops growing (the dry contact law takes
+        over at ``eps = 1``); keeps the film's ``(1 - eps^2)^-5/2`` finite.
+    """
+
+    name: str
+    journal: object
+    journal_frame: str
+    bearing: object
+    bearing_frame: str
+    clearance: float
+    journal_radius: float
+    law: str = "impact"
+    law_params: dict = field(default_factory=dict)
+    friction: str = "none"
+    friction_params: dict = field(default_factory=dict)
+    v_impact_min: float = 1e-3
+    clearance_major: float | None = None
+    wear_angle: float = 0.0
+    viscosity: float | None = None
+    bearing_length: float = 0.0
+    eps_max: float = 0.95
+    # contact memory (restitution laws): impact velocity of the current contact
+    v_impact: float = 1e-3
+
+    @property
+    def needs_memory(self) -> bool:
+        return self.law in contact.RESTITUTION_LAWS
+
+    def kinematics(self, sysm, q, qd):
+        """Eccentricity, penetration, penetration rate, slip velocity, and the frame data."""
+        pj, Jj, _ = sysm.frame(self.journal, self.journal_frame, q, qd)
+        pb, Jb, _ = sysm.frame(self.bearing, self.bearing_frame, q, qd)
+        vj = sysm.frame_velocity(self.journal, Jj, qd)
+        vb = sysm.frame_velocity(self.bearing, Jb, qd)
+        e = pj[:2] - pb[:2]
+        d = float(np.hypot(e[0], e[1]))
+        # direction is irrelevant inside the clearance; avoid 0/0 at the exact centre
+        n = e / d if d > 1e-300 else np.array([1.0, 0.0])
+        t = np.array([-n[1], n[0]])
+        vrel = vj[:2] - vb[:2]
+        c, dc = self.bore_clearance(np.arctan2(n[1], n[0]) - pb[2])
+        delta = d - c
+        grad = n - (dc / d) * t if (dc != 0.0 and d > 1e-300) else n  # d delta / d e
+        delta_dot = float(grad @ vrel + dc * vb[2])
+        r_b = self.journal_radius + c
+        v_slip = float(t @ vrel + self.journal_radius * vj[2] - r_b * vb[2])
+        return dict(e=e, n=n, t=t, grad=grad, dtheta=dc, delta=delta, delta_dot=delta_dot,
+                    v_slip=v_slip, Jj=Jj, Jb=Jb, r_b=r_b, d=d, vrel=vrel,
+                    omega_sum=float(vj[2] + vb[2]))
+
+    def bore_clearance(self, phi):
+        """Radial clearance (m) of the bore in direction ``phi`` (bearing frame) and its derivative.
+
+        Round bore: ``(c, 0)``. Worn bore: polar radius of the ellipse minus the journal radius.
+        """
+        if self.clearance_major is None:
+            return self.clearance, 0.0
+        a = self.journal_radius + self.clearance_major
+        b = self.journal_radius + self.clearance
+        ph = phi - self.wear_angle
+        cs, sn = np.cos(ph), np.sin(ph)
+        s2 = (b * cs) ** 2 + (a * sn) ** 2
+        rho = a * b / np.sqrt(s2)
+        drho = -a * b * (a * a - b * b) * sn * cs / s2**1.5
+        return float(rho - self.journal_radius), float(drho)
+
+    def film_force(self, k) -> np.ndarray:
+        """Short-bearing film force on the journal (global x, y), N."""
+        c = self.clearance
+        d = k["d"]
+        eps = min(d / c, self.eps_max)
+        n, t = k["n"], k["t"]
+        gamma_dot = float(t @ k["vrel"]) / d if d > 1e-12 * c else 0.0
+        fr, ftan = short_bearing_force(eps, float(n @ k["vrel"]) / c, gamma_dot, k["omega_sum"],
+                                       self.viscosity, self.journal_radius, self.bearing_length,
+                                       c)
+        return float(fr) * n + float(ftan) * t
+
+    def gap(self, sysm, q) -> float:
+        """Penetration ``|e| - c`` from positions only, m (event function)."""
+        pj = sysm.frame_pose_only(self.journal, self.journal_frame, q)
+        pb = sysm.frame_pose_only(self.bearing, self.bearing_frame, q)
+        ex, ey = pj[0] - pb[0], pj[1] - pb[1]
+        c, _ = self.bore_clearance(np.arctan2(ey, ex) - pb[2])
+        return float(np.hypot(ex, ey)) - c
+
+    def forces(self, sysm, t, q, qd, Q):
+        """Add the contact forces to ``Q``; return the diagnostics and dissipated powers."""
+        k = self.kinematics(sysm, q, qd)
+        delta, ddot = k["delta"], k["delta_dot"]
+        if delta > 0.0:
+            fn = float(contact.normal_force(self.law, delta, ddot, self.law_params,
+                                            max(self.v_impact, self.v_impact_min)))
+            fel = float(contact.elastic_force(self.law, delta, self.law_params))
+            mu = float(contact.friction_coefficient(self.friction, k["v_slip"],
+                                                    self.friction_params))
+        else:
+            fn = fel = mu = 0.0
+        ft = -mu * fn
+        g, tt = k["grad"], k["t"]
+        f = -fn * g + ft * tt  # force on the journal, N
+        p_film = 0.0
+        f_film = np.zeros(2)
+        if self.viscosity is not None:
+            f_film = self.film_force(k)
+            p_film = float(f_film @ k["vrel"])
+            f = f + f_film
+        if fn != 0.0 or p_film != 0.0:
+            sysm.add_frame_force(Q, self.journal, k["Jj"],
+                                 np.array([f[0], f[1], self.journal_radius * ft]))
+            sysm.add_frame_force(Q, self.bearing, k["Jb"],
+                                 np.array([-f[0], -f[1], -k["r_b"] * ft - fn * k["dtheta"]]))
+        k.update(fn=fn, ft=ft, force=f, film=float(np.hypot(*f_film)),
+                 p_damp=(fn - fel) * ddot - p_film, p_fric=-ft * k["v_slip"],
+                 v_elastic=float(contact.elastic_energy(self.law, delta, self.law_params)))
+        return k

@@ -1,0 +1,121 @@
+"""Ideal joints and the crank drive as algebraic constraints on interface frames.
+
+Every constraint ``Phi(q, t) = 0`` supplies its value, its Jacobian blocks per body, the
+velocity right-hand side ``nu = -Phi_t`` and the acceleration right-hand side
+``gamma = -(Jdot qdot) - Phi_tt`` so that ``Phi_q qddot = gamma``. The Lagrange multipliers
+``lam`` make ``-Phi_q^T lam`` the constraint forces on the bodies.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contact import step
+
+
+@dataclass
+class Revolute:
+    """Pin between frame ``frame_a`` of body ``a`` and ``frame_b`` of body ``b`` (2 equations).
+
+    The multiplier ``lam`` (N) is the force that body ``a`` exerts on body ``b``.
+    """
+
+    name: str
+    a: object
+    frame_a: str
+    b: object
+    frame_b: str
+    n_eq = 2
+
+    def blocks(self, sysm, t, q, qd):
+        pa, Ja, ba = sysm.frame(self.a, self.frame_a, q, qd)
+        pb, Jb, bb = sysm.frame(self.b, self.frame_b, q, qd)
+        phi = pa[:2] - pb[:2]
+        gamma = -(ba[:2] - bb[:2])
+        return phi, [(self.a, Ja[:2]), (self.b, -Jb[:2])], np.zeros(2), gamma
+
+
+@dataclass
+class Prismatic:
+    """Slider of body ``a`` (frame ``frame_a``) along a fixed line of the ground (2 equations).
+
+    The line passes through ``origin`` (m) with unit direction ``axis``; the slider keeps the
+    orientation ``angle`` (rad). Multipliers: the force (N) across the line the slider exerts on
+    the guide, and the moment (N m) it exerts on the guide.
+    """
+
+    name: str
+    a: object
+    frame_a: str
+    origin: np.ndarray
+    axis: np.ndarray
+    angle: float = 0.0
+    n_eq = 2
+
+    def blocks(self, sysm, t, q, qd):
+        pa, Ja, ba = sysm.frame(self.a, self.frame_a, q, qd)
+        n = np.array([-self.axis[1], self.axis[0]])
+        phi = np.array([n @ (pa[:2] - self.origin), pa[2] - self.angle])
+        J = np.vstack([n @ Ja[:2], Ja[2]])
+        gamma = -np.array([n @ ba[:2], ba[2]])
+        return phi, [(self.a, J)], np.zeros(2), gamma
+
+
+@dataclass
+class SpeedProfile:
+    """Prescribed crank angle: constant speed, optionally reached by an ADAMS STEP ramp.
+
+    ``omega(t) = omega * STEP(t, 0, omega_start/omega, ramp_time, 1)``; angle from ``theta0``.
+    Units rad, rad/s, s.
+    """
+
+    omega: float
+    theta0: float = 0.0
+    ramp_time: float = 0.0
+    omega_start: float = 0.0
+
+    def _s(self, t):
+        return min(max(t / self.ramp_time, 0.0), 1.0)
+
+    def angle(self, t: float) -> float:
+        if self.ramp_time <= 0.0:
+            return self.theta0 + self.omega * t
+        w0, dw, T = self.omega_start, self.omega - self.omega_start, self.ramp_time
+        if t >= T:
+            return self.theta0 + w0 * t + dw * (T / 2 + (t - T))
+        s = self._s(t)
+        return self.theta0 + w0 * t + dw * T * (s**3 - 0.5 * s**4)
+
+    def speed(self, t: float) -> float:
+        if self.ramp_time <= 0.0:
+            return self.omega
+        return float(step(t, 0.0, self.omega_start, self.ramp_time, self.omega))
+
+    def acceleration(self, t: float) -> float:
+        if self.ramp_time <= 0.0 or t >= self.ramp_time or t <= 0.0:
+            return 0.0
+        s = self._s(t)
+        return (self.omega - self.omega_start) * 6.0 * s * (1.0 - s) / self.ramp_time
+
+
+@dataclass
+class AngleDrive:
+    """Rheonomic constraint ``phi_a(q) - theta(t) = 0`` on frame ``frame_a`` of the crank.
+
+    Its multiplier is minus the drive torque (N m) applied to the crank.
+    """
+
+    name: str
+    a: object
+    frame_a: str
+    profile: SpeedProfile
+    n_eq = 1
+
+    def blocks(self, sysm, t, q, qd):
+        pa, Ja, ba = sysm.frame(self.a, self.frame_a, q, qd)
+        phi = np.array([pa[2] - self.profile.angle(t)])
+        nu = np.array([self.profile.speed(t)])
+        gamma = np.array([-ba[2] + self.profile.acceleration(t)])
+        return phi, [(self.a, Ja[2:3])], nu, gamma

@@ -1,0 +1,263 @@
+"""Mechanisms from parameters: slider-crank trains (single, offset, four-star) and the four-bar.
+
+A builder returns a :class:`Mechanism`: the multibody system with the requested clearance
+joints, its ideal-joint twin (same bodies, every clearance joint replaced by a pin) and a
+consistent initial state in which every journal sits at its bearing centre.
+
+Angles: the crank angle ``theta`` is measured from the global x axis; cylinder ``i`` has its axis
+at ``psi_i`` (unit vector from the crank towards the head) and is at top dead centre when
+``theta = psi_i`` (zero offset).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .bodies import Ground, RigidBody
+from .clearance import ClearanceJoint
+from .joints import AngleDrive, Prismatic, Revolute, SpeedProfile
+from .loads import CrankTorque, PistonLoads
+from .system import Multibody
+
+
+@dataclass
+class Cylinder:
+    """One cylinder of a crank train (SI units, angles in rad).
+
+    ``rod_com`` is the distance of the rod's centre of mass from the big-end centre; ``offset``
+    the piston-pin offset across the cylinder axis (positive towards +90 deg from the axis);
+    ``z`` the axial row position along the crankpin (for 3D moments).
+    """
+
+    axis_angle: float
+    rod_length: float
+    rod_mass: float
+    rod_inertia: float
+    rod_com: float
+    piston_mass: float
+    offset: float = 0.0
+    z: float = 0.0
+    gas_force: object = None
+    ring_friction: float = 0.0
+
+
+@dataclass
+class Mechanism:
+    """A built mechanism: systems, initial state and what the outputs need to know."""
+
+    kind: str
+    system: Multibody
+    ideal: Multibody
+    q0: np.ndarray
+    qd0: np.ndarray
+    crank: RigidBody
+    pistons: list = field(default_factory=list)
+    axes: list = field(default_factory=list)
+    revolution_hz: float = 1.0
+    main_joint: str = "main"
+    rows_z: dict = field(default_factory=dict)
+
+    def constraint_index(self, name, ideal=False):
+        sysm = self.ideal if ideal else self.system
+        for c, r in zip(sysm.constraints, sysm.rows):
+            if c.name == name:
+                return r
+        raise KeyError(name)
+
+
+def _unit(angle):
+    return np.array([np.cos(angle), np.sin(angle)])
+
+
+def _split(pins, clearance_specs, contact_kw):
+    """Ideal pins and clearance joints from the pin list and {name: spec}."""
+    ideal_pins, clear = [], []
+    for p in pins:
+        spec = clearance_specs.get(p.name)
+        if spec is None:
+            ideal_pins.append(p)
+            continue
+        kw = dict(contact_kw)
+        kw.update(spec.get("contact", {}))  # per-joint overrides (e.g. a stiffness from the radii)
+        clear.append(ClearanceJoint(
+            name=p.name, journal=p.a, journal_frame=p.frame_a, bearing=p.b, bearing_frame=p.frame_b,
+            clearance=spec["clearance"], journal_radius=spec["journal_radius"],
+            clearance_major=spec.get("clearance_major"), wear_angle=spec.get("wear_angle", 0.0),
+            viscosity=spec.get("viscosity"), bearing_length=spec.get("bearing_length", 0.0),
+            **kw))
+    unknown = set(clearance_specs) - {p.name for p in pins}
+    if unknown:
+        names = ", ".join(p.name for p in pins)
+        raise KeyError(f"no joint named {min(unknown)!r}; joints are: {names}")
+    return ideal_pins, clear
+
+
+def _finish(kind, bodies, pins, others, loads, clearance_specs, contact_kw, q0, qd0, crank,
+            drive, gravity, baumgarte, **meta):
+    ideal_pins, clear = _split(pins, clearance_specs, contact_kw)
+    assembly = Multibody(bodies, pins + others, [], loads, gravity, baumgarte)
+    q, qd = assembly.assemble(0.0, q0, qd0)
+    extra = []
+    if not isinstance(drive, AngleDrive):  # free speed: assembled at omega0, then torque-driven
+        others = [c for c in others if not isinstance(c, AngleDrive)]
+        extra = [drive]
+    ideal = Multibody(bodies, pins + others, [], loads + extra, gravity, baumgarte)
+    system = Multibody(bodies, ideal_pins + others, clear, loads + extra, gravity, baumgarte)
+    return Mechanism(kind=kind, system=system, ideal=ideal, q0=q, qd0=qd, crank=crank, **meta)
+
+
+def _drive(crank, omega, theta0, ramp_time, drive_torque, crank_frame="main"):
+    """The angle drive used for assembly, and the drive of the run (same, or a torque)."""
+    omega_start = 0.0 if ramp_time > 0.0 else omega
+    angle = AngleDrive("drive", crank, crank_frame,
+                       SpeedProfile(omega, theta0, ramp_time, omega_start))
+    if drive_torque is None:
+        return angle, angle
+    return angle, CrankTorque(crank, crank_frame, drive_torque)
+
+
+def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inertia=0.0,
+                crank_com=0.0, theta0=0.0, ramp_time=0.0, drive_torque=None, clearances=None,
+                contact_kw=None, gravity=(0.0, 0.0), baumgarte=None, kind="slider_crank",
+                direction=1):
+    """Slider-crank train: one crank, ``len(cylinders)`` rods on one crankpin, pistons.
+
+    Parameters
+    ----------
+    crank_radius : float
+        m.
+    cylinders : list of Cylinder
+    speed_rpm : float
+        Crank speed (prescribed, or initial when ``drive_torque`` is given).
+    crank_mass, crank_inertia, crank_com : float
+        kg, kg m^2 about its centre of mass, and the distance of that centre from the crank axis
+        along the crank (negative: counterweight side), m.
+    theta0 : float
+        Initial crank angle, rad.
+    ramp_time : float
+        Speed ramp from rest (ADAMS STEP), s; 0 starts at full speed.
+    drive_torque : float or None
+        None: prescribed speed. A number: constant torque (N m) with the speed free (put the
+        flywheel into ``crank_inertia``).
+    clearances : dict, optional
+        ``{joint_name: {"clearance": m, "journal_radius": m, "contact": {overrides}}}``, for a
+        worn (elliptical) bore also ``clearance_major`` (m) and ``wear_angle`` (rad), for a
+        lubricated one ``viscosity`` (Pa s) and ``bearing_length`` (m);
+        joints are ``main``,
+        ``big_end_<i>``, ``small_end_<i>`` (i from 1).
+    contact_kw : dict, optional
+        ``law, law_params, friction, friction_params, v_impact_min`` of the clearance joints.
+    gravity : (2,)
+        m/s^2.
+    baumgarte : float, optional
+        Stabilisation rate, 1/s (default: 2 crank speeds, at least 50).
+    direction : {1, -1}
+        Sense of rotation: 1 counter-clockwise (angles grow), -1 clockwise. A cylinder's angle
+        from its top dead centre is ``direction * (theta - psi_i)``.
+    """
+    omega = direction * speed_rpm * 2.0 * np.pi / 60.0
+    baumgarte = max(50.0, 2.0 * abs(omega)) if baumgarte is None else baumgarte
+    ground = Ground(frames={"main": (0.0, 0.0)})
+    r, b = crank_radius, crank_com
+    crank = RigidBody("crank", max(crank_mass, 0.0), max(crank_inertia, 1e-12),
+                      {"main": (-b, 0.0), "pin": (r - b, 0.0)})
+    bodies, q0, qd0 = [crank], [], []
+    rw = omega if ramp_time <= 0.0 else 0.0
+    c0, s0 = np.cos(theta0), np.sin(theta0)
+    q0 += [b * c0, b * s0, theta0]
+    qd0 += [-b * s0 * rw, b * c0 * rw, rw]
+    pins = [Revolute("main", crank, "main", ground, "main")]
+    others, loads, pistons, axes, rows_z = [], [], [], [], {}
+    angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque)
+    others.append(angle_drive)
+    P = r * np.array([c0, s0])
+    for i, cyl in enumerate(cylinders, start=1):
+        u = _unit(cyl.axis_angle)
+        nrm = np.array([-u[1], u[0]])
+        a, L = cyl.rod_com, cyl.rod_length
+        rod = RigidBody(f"rod_{i}", cyl.rod_mass, cyl.rod_inertia,
+                        {"big": (-a, 0.0), "small": (L - a, 0.0)}, z=cyl.z)
+        piston = RigidBody(f"piston_{i}", cyl.piston_mass, 1.0e-6, {"pin": (0.0, 0.0)}, z=cyl.z)
+        h = P @ nrm - cyl.offset
+        if abs(h) >= L:
+            raise ValueError(f"cylinder {i}: rod length {L} m cannot reach the crankpin")
+        s = P @ u + np.sqrt(L * L - h * h)
+        X = s * u + cyl.offset * nrm
+        d = X - P
+        phi = np.arctan2(d[1], d[0])
+        G = P + a * d / L
+        q0 += [G[0], G[1], phi, X[0], X[1], cyl.axis_angle]
+        qd0 += [0.0] * 6
+        bodies += [rod, piston]
+        pins += [Revolute(f"big_end_{i}", crank, "pin", rod, "big"),
+                 Revolute(f"small_end_{i}", piston, "pin", rod, "small")]
+        others.append(Prismatic(f"slider_{i}", piston, "pin", cyl.offset * nrm, u, cyl.axis_angle))
+        loads.append(PistonLoads(piston, "pin", u, cyl.axis_angle, crank, "main",
+                                 cyl.gas_force, cyl.ring_friction, sense=direction))
+        pistons.append(piston)
+        axes.append(u)
+        rows_z[f"big_end_{i}"] = cyl.z
+    return _finish(kind, bodies, pins, others, loads, clearances or {}, contact_kw or {},
+                   np.array(q0), np.array(qd0), crank, drive, gravity, baumgarte,
+                   pistons=pistons, axes=axes, revolution_hz=speed_rpm / 60.0, rows_z=rows_z)
+
+
+def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, inertias,
+             speed_rpm, com_fractions=(0.0, 0.5, 0.5), extra_rocker_inertia=0.0, theta0=0.0,
+             ramp_time=0.0, drive_torque=None, branch=1, clearances=None, contact_kw=None,
+             gravity=(0.0, 0.0), baumgarte=None, direction=1):
+    """Four-bar crank-rocker: crank A-B, coupler B-C, rocker D-C; joints ``A, B, C, D``.
+
+    Parameters
+    ----------
+    crank_length, coupler_length, rocker_length : float
+        m.
+    rocker_pivot : (2,)
+        Position of D, m (A at the origin).
+    masses, inertias : 3 floats each
+        Crank, coupler, rocker: kg and kg m^2 about the centre of mass.
+    com_fractions : 3 floats
+        Centre of mass of each link as a fraction of its length from A, B, D respectively.
+    extra_rocker_inertia : float
+        Inertia rigidly attached to the rocker about D (e.g. sley and sword), kg m^2.
+    branch : {1, -1}
+        Assembly mode (which side of BD the joint C lies on).
+    direction : {1, -1}
+        Sense of rotation of the crank (1 counter-clockwise).
+    """
+    omega = direction * speed_rpm * 2.0 * np.pi / 60.0
+    baumgarte = max(50.0, 2.0 * abs(omega)) if baumgarte is None else baumgarte
+    D = np.asarray(rocker_pivot, float)
+    ground = Ground(frames={"A": (0.0, 0.0), "D": (D[0], D[1])})
+    l1, l2, l3 = crank_length, coupler_length, rocker_length
+    f1, f2, f3 = com_fractions
+    crank = RigidBody("crank", masses[0], max(inertias[0], 1e-12),
+                      {"A": (-f1 * l1, 0.0), "B": ((1 - f1) * l1, 0.0)})
+    coupler = RigidBody("coupler", masses[1], inertias[1],
+                        {"B": (-f2 * l2, 0.0), "C": ((1 - f2) * l2, 0.0)})
+    m3 = masses[2]
+    i3 = inertias[2] + extra_rocker_inertia
+    rocker = RigidBody("rocker", m3, i3, {"D": (-f3 * l3, 0.0), "C": ((1 - f3) * l3, 0.0)})
+    B = l1 * _unit(theta0)
+    BD = D - B
+    dist = np.hypot(*BD)
+    if not abs(l2 - l3) < dist < l2 + l3:
+        raise ValueError("four-bar cannot be assembled at the initial crank angle")
+    x = (dist**2 + l2**2 - l3**2) / (2 * dist)
+    y = branch * np.sqrt(l2**2 - x**2)
+    ebd = BD / dist
+    C = B + x * ebd + y * np.array([-ebd[1], ebd[0]])
+    phi2 = np.arctan2(*(C - B)[::-1])
+    phi3 = np.arctan2(*(C - D)[::-1])
+    q0 = np.array([*(f1 * B), theta0, *(B + f2 * (C - B)), phi2, *(D + f3 * (C - D)), phi3])
+    rw = omega if ramp_time <= 0.0 else 0.0
+    qd0 = np.zeros(9)
+    qd0[2] = rw
+    pins = [Revolute("A", crank, "A", ground, "A"), Revolute("B", crank, "B", coupler, "B"),
+            Revolute("C", rocker, "C", coupler, "C"), Revolute("D", rocker, "D", ground, "D")]
+    angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque, "A")
+    return _finish("four_bar", [crank, coupler, rocker], pins, [angle_drive], [],
+                   clearances or {}, contact_kw or {}, q0, qd0, crank, drive, gravity,
+                   baumgarte, revolution_hz=speed_rpm / 60.0, main_joint="A")

@@ -1,0 +1,153 @@
+"""PNG figures of a dynamics run (matplotlib, Agg backend, imported here only)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_piston(hist, ideal, path: Path, piston: int = 0) -> Path:
+    """Piston acceleration against time and the acceleration-velocity phase diagram."""
+    plt = _plt()
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    if ideal is not None:
+        ax[0].plot(ideal.t, ideal.piston_acceleration[:, piston], "k--", lw=0.8, label="ideal")
+        ax[1].plot(ideal.piston_velocity[:, piston], ideal.piston_acceleration[:, piston], "k--",
+                   lw=0.8, label="ideal")
+    ax[0].plot(hist.t, hist.piston_acceleration[:, piston], lw=0.7, label="with clearance")
+    ax[1].plot(hist.piston_velocity[:, piston], hist.piston_acceleration[:, piston], lw=0.5)
+    ax[0].set(xlabel="t [s]", ylabel="piston acceleration [m/s²]", title=f"piston {piston + 1}")
+    ax[1].set(xlabel="piston velocity [m/s]", ylabel="piston acceleration [m/s²]",
+              title="phase diagram")
+    ax[0].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_bearing_force(hist, spectrum, path: Path, ideal_spectrum=None) -> Path:
+    """Main-bearing force components over time and their amplitude spectrum (Hz and orders)."""
+    plt = _plt()
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    ax[0].plot(hist.t, hist.main_bearing_force[:, 0], lw=0.7, label="F_x")
+    ax[0].plot(hist.t, hist.main_bearing_force[:, 1], lw=0.7, label="F_y")
+    ax[0].set(xlabel="t [s]", ylabel="main-bearing force [N]")
+    ax[0].legend()
+    f = spectrum.frequency_hz
+    if ideal_spectrum is not None:
+        ax[1].semilogy(ideal_spectrum.frequency_hz, ideal_spectrum.amplitude[:, 0] + 1e-9, "k--",
+                       lw=0.8, label="ideal F_x")
+    ax[1].semilogy(f, spectrum.amplitude[:, 0] + 1e-9, lw=0.8, label="F_x")
+    ax[1].semilogy(f, spectrum.amplitude[:, 1] + 1e-9, lw=0.8, label="F_y")
+    ax[1].set(xlabel="frequency [Hz]", ylabel="amplitude [N]", xlim=(0, min(f[-1], 2000.0)))
+    sec = ax[1].secondary_xaxis("top", functions=(lambda x: x / _rev(spectrum),
+                                                  lambda o: o * _rev(spectrum)))
+    sec.set_xlabel("engine order")
+    ax[1].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def _rev(spectrum):
+    k = np.flatnonzero(spectrum.order > 0)
+    return spectrum.frequency_hz[k[0]] / spectrum.order[k[0]] if k.size else 1.0
+
+
+def plot_orbit(hist, clearances, path: Path) -> Path:
+    """Journal-centre orbit relative to the bore (bearing body's frame), in units of c."""
+    plt = _plt()
+    n = max(len(clearances), 1)
+    fig, axs = plt.subplots(1, n, figsize=(4.5 * n, 4.5), squeeze=False)
+    for ax, (name, c) in zip(axs[0], clearances.items()):
+        d = hist.contact[name]
+        th = np.linspace(0, 2 * np.pi, 200)
+        ax.plot(np.cos(th), np.sin(th), "k-", lw=0.8)
+        ax.plot(d["ex_bearing"] / c, d["ey_bearing"] / c, lw=0.6)
+        ax.set(aspect="equal", xlabel="e_x / c (bearing frame)", ylabel="e_y / c",
+               title=f"journal orbit, {name}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_contact(hist, path: Path) -> Path:
+    """Normal contact force and penetration of each clearance joint, impacts marked."""
+    plt = _plt()
+    fig, ax = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    for name, d in hist.contact.items():
+        ax[0].plot(hist.t, d["fn"], lw=0.7, label=name)
+        ax[1].plot(hist.t, np.maximum(d["penetration"], 0.0) * 1e6, lw=0.7, label=name)
+        ons = np.asarray(hist.onsets.get(name, []), float).reshape(-1, 2)
+        if ons.size:
+            ax[0].plot(ons[:, 0], np.zeros(len(ons)), "rv", ms=3)
+    ax[0].set(ylabel="normal force [N]")
+    ax[1].set(xlabel="t [s]", ylabel="penetration [µm]")
+    ax[0].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_drive(hist, ideal, path: Path) -> Path:
+    """Drive torque and power against time."""
+    plt = _plt()
+    fig, ax = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
+    if ideal is not None:
+        ax[0].plot(ideal.t, ideal.drive_torque, "k--", lw=0.8, label="ideal")
+        ax[1].plot(ideal.t, ideal.drive_power, "k--", lw=0.8)
+    ax[0].plot(hist.t, hist.drive_torque, lw=0.7, label="with clearance")
+    ax[1].plot(hist.t, hist.drive_power, lw=0.7)
+    ax[0].set(ylabel="drive torque [N m]")
+    ax[1].set(xlabel="t [s]", ylabel="drive power [W]")
+    ax[0].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_energy(hist, path: Path) -> Path:
+    """Energy bookkeeping: every term and the balance residual."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    for k, v in hist.energy.items():
+        ax.plot(hist.t, v, lw=1.2 if k == "residual" else 0.8, label=k)
+    ax.set(xlabel="t [s]", ylabel="energy [J]")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_study(study, path: Path) -> Path:
+    """Error of the key outputs against wall time over the tolerance sequence."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    w = np.asarray(study["wall_time_s"])
+    for k in ("d_peak_contact_force", "d_peak_piston_acceleration", "d_main_bearing_order_rms"):
+        ax.loglog(w[:-1], np.maximum(np.asarray(study[k])[:-1], 1e-12), "o-", label=k[2:])
+    for x, y, r in zip(w[:-1], np.asarray(study["d_peak_piston_acceleration"])[:-1],
+                       study["rtol"][:-1]):
+        ax.annotate(f"rtol {r:g}", (x, max(y, 1e-12)), fontsize=7)
+    ax.set(xlabel="wall time [s]", ylabel="relative change vs tightest rtol")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -1,0 +1,228 @@
+"""The ``[dynamics]`` scene section: keys, checks, and the mechanism they describe."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import SceneError
+from ..schema import Field, validate
+from . import contact
+
+MECHANISMS = ("slider_crank", "four_star", "four_bar")
+METHODS = ("auto", "LSODA", "Radau", "BDF", "RK45", "DOP853")
+
+SCHEMA = {
+    "machine": Field("str", None, "machine file whose [dynamics] table gives the defaults"),
+    "mechanism": Field("str", "slider_crank", "slider_crank, four_star or four_bar",
+                       choices=MECHANISMS),
+    "speed_rpm": Field("float", None, "crank speed (prescribed, or initial for a torque drive), "
+                       "rpm; default: [mechanism] speed_rpm with from_mechanism", gt=0.0,
+                       le=20000.0),
+    "rotation": Field("str", "ccw", "sense of crank rotation in the x-y plane: ccw or cw "
+                      "(from_mechanism sets cw)", choices=("ccw", "cw")),
+    "from_mechanism": Field("bool", False, "take crank, rods, pistons, row offsets and gas forces "
+                            "from the scene's [mechanism] section"),
+    "ramp_time": Field("float", 0.0, "s, speed ramp from rest (ADAMS STEP); 0 starts at full speed",
+                       ge=0.0),
+    "drive_torque": Field("float", None, "N m; if given the speed is free and this torque drives"),
+    "initial_angle_deg": Field("float", 0.0, "initial crank angle, deg from the x axis"),
+    "end_time": Field("float", 0.2, "simulated time, s", gt=0.0, le=100.0),
+    "output_step": Field("float", None, "output sampling step, s (default: 1 deg of crank)",
+                         gt=0.0),
+    "spectrum_start": Field("float", None, "start of the spectrum window, s (default: after the "
+                            "ramp and one revolution)", ge=0.0),
+    "gravity": Field("floats", [0.0, 0.0], "gravity vector in the plane, m/s^2", length=2),
+    "gas_force_deg": Field("floats", None, "crank angles from each cylinder's TDC of the gas-force "
+                           "table, deg, increasing"),
+    "gas_force_n": Field("floats", None, "gas force on the piston, N, positive towards the crank"),
+    "gas_cycle_deg": Field("float", 360.0, "360 (compressor, two-stroke) or 720 (four-stroke)",
+                           check=lambda v: None if v in (360.0, 720.0) else "must be 360 or 720"),
+    "ring_friction_n": Field("float", 0.0, "piston ring friction force, N", ge=0.0),
+    "energy_tolerance": Field("float", 1e-3, "admissible energy-balance residual (relative)",
+                              gt=0.0),
+    "run_ideal": Field("bool", True, "also run the ideal-joint twin (reference, contact loss)"),
+    "crank_train": Field("table", {}, "slider-crank / four-star geometry and masses"),
+    "four_bar": Field("table", {}, "four-bar geometry and masses"),
+    "clearances": Field("tables", [], "clearance joints: [{joint, clearance (m), journal_radius (m)}]"),
+    "contact": Field("table", {}, "normal contact law and parameters"),
+    "friction": Field("table", {}, "friction law and parameters"),
+    "solver": Field("table", {}, "integrator settings"),
+}
+
+CRANK_TRAIN = {
+    "crank_radius": Field("float", 0.035, "m", gt=0.0),
+    "rod_length": Field("float", 0.28, "m", gt=0.0),
+    "rod_mass": Field("float", 0.9, "kg", gt=0.0),
+    "rod_inertia": Field("float", None, "kg m^2 about the rod centre of mass (default 0.175 m L^2, "
+                         "seed 003)", gt=0.0),
+    "rod_com": Field("float", None, "distance of the rod centre of mass from the big end, m "
+                     "(default 0.3 L)", ge=0.0),
+    "piston_mass": Field("float", 1.2, "kg (piston, pin, rings)", gt=0.0),
+    "crank_mass": Field("float", 0.0, "kg", ge=0.0),
+    "crank_inertia": Field("float", 0.0, "kg m^2 about its centre of mass (add the flywheel here)",
+                           ge=0.0),
+    "crank_com": Field("float", 0.0, "centre of mass from the axis along the crank, m", ),
+    "offset": Field("float", 0.0, "piston-pin offset across the cylinder axis, m"),
+    "cylinder_angles_deg": Field("floats", None, "cylinder axis angles from x, deg (slider_crank "
+                                 "[0], four_star [90, 270, 0, 180])"),
+    "row_z": Field("floats", None, "axial row position of each rod on the crankpin, m"),
+}
+
+FOUR_BAR = {
+    "lengths": Field("floats", [0.035, 0.075, 0.145], "crank AB, coupler BC, rocker DC, m",
+                     length=3, gt=0.0),
+    "rocker_pivot": Field("floats", [0.008, 0.1598], "D relative to A, m", length=2),
+    "masses": Field("floats", [35.8, 2.27, 10.42], "kg", length=3, gt=0.0),
+    "inertias": Field("floats", [0.0155, 0.0114, 0.0528], "kg m^2 about the centres of mass",
+                      length=3, ge=0.0),
+    "com_fractions": Field("floats", [0.0, 0.5, 0.5], "centre of mass along crank/coupler/rocker",
+                           length=3),
+    "extra_rocker_inertia": Field("float", 0.3728, "sley and sword about D, kg m^2", ge=0.0),
+    "branch": Field("int", 1, "assembly mode, 1 or -1", check=lambda v: None if v in (1, -1)
+                    else "must be 1 or -1"),
+}
+
+CLEARANCE = {
+    "joint": Field("str", "big_end_1", "joint name: main, big_end_i, small_end_i (crank trains); "
+                   "A, B, C, D (four-bar)"),
+    "clearance": Field("float", 1e-4, "radial clearance, m", gt=0.0, le=0.01),
+    "journal_radius": Field("float", 0.02, "m", gt=0.0),
+    "clearance_major": Field("float", None, "worn bearing (seed 003): radial clearance along the "
+                             "major axis of the elliptical bore, m (clearance is the minor one)",
+                             gt=0.0, le=0.01),
+    "wear_angle_deg": Field("float", 0.0, "major axis of the worn bore from the bearing body's "
+                            "axis (rod axis for big and small ends), deg"),
+    "viscosity": Field("float", None, "lubricant dynamic viscosity, Pa s: adds the short-bearing "
+                       "(Ocvirk) film force", gt=0.0),
+    "bearing_length": Field("float", None, "bearing length for the film force, m", gt=0.0),
+}
+
+CONTACT = {
+    "law": Field("str", "impact", "normal force law", choices=contact.NORMAL_LAWS),
+    "stiffness": Field("float", None, "N/m^exponent (default: from E, nu and the radii)", gt=0.0),
+    "exponent": Field("float", 1.5, "force exponent", gt=0.0, le=3.0),
+    "damping": Field("float", 300.0, "N s/m (impact: full damping; kelvin_voigt, power_damped)", ge=0.0),
+    "penetration": Field("float", 1e-4, "impact: penetration of full damping, m", gt=0.0),
+    "restitution": Field("float", 0.9, "hunt_crossley / lankarani_nikravesh / flores", gt=0.0,
+                         le=1.0),
+    "v_impact_min": Field("float", 1e-3, "floor of the impact velocity, m/s", gt=0.0),
+    "E": Field("float", 2.1e11, "Young's modulus of journal and bearing, Pa", gt=0.0),
+    "nu": Field("float", 0.3, "Poisson's ratio", ge=0.0, lt=0.5),
+}
+
+FRICTION = {
+    "law": Field("str", "none", "none, coulomb or ambrosio", choices=contact.FRICTION_LAWS),
+    "mu_static": Field("float", 0.05, "static coefficient", ge=0.0),
+    "mu_dynamic": Field("float", 0.08, "dynamic coefficient", ge=0.0),
+    "v_static": Field("float", 1e-4, "stiction transition velocity, m/s", gt=0.0),
+    "v_dynamic": Field("float", 1e-2, "friction transition velocity, m/s", gt=0.0),
+}
+
+SOLVER = {
+    "method": Field("str", "auto", "solve_ivp method; auto: RK45 (fastest measured, also for "
+                    "stiff contact), LSODA when friction sticks (slow sliding)", choices=METHODS),
+    "rtol": Field("float", 1e-6, "relative tolerance", gt=0.0, lt=1.0),
+    "atol": Field("float", None, "absolute position tolerance, m (default min(1e-9, c/1e4))",
+                  gt=0.0),
+    "max_step_deg": Field("float", 2.0, "largest step, deg of crank", gt=0.0, le=90.0),
+    "max_rhs_evals": Field("int", 2_000_000, "budget of right-hand-side evaluations", gt=0),
+    "baumgarte": Field("float", None, "constraint stabilisation rate, 1/s (default 2 omega)",
+                       gt=0.0),
+    "study_rtols": Field("floats", [], "tolerances of the error-against-run-time study", gt=0.0,
+                         lt=1.0),
+}
+
+
+def validate_section(raw: dict) -> dict:
+    """Validate ``[dynamics]`` and its sub-tables; return the parameters."""
+    p = validate("dynamics", raw, SCHEMA)
+    p["crank_train"] = validate("dynamics.crank_train", p["crank_train"], CRANK_TRAIN)
+    p["four_bar"] = validate("dynamics.four_bar", p["four_bar"], FOUR_BAR)
+    p["clearances"] = [validate(f"dynamics.clearances[{i}]", c, CLEARANCE)
+                       for i, c in enumerate(p["clearances"])]
+    p["contact"] = validate("dynamics.contact", p["contact"], CONTACT)
+    p["friction"] = validate("dynamics.friction", p["friction"], FRICTION)
+    p["solver"] = validate("dynamics.solver", p["solver"], SOLVER)
+    _cross_checks(p)
+    return p
+
+
+def joint_names(p) -> list[str]:
+    if p["mechanism"] == "four_bar":
+        return ["A", "B", "C", "D"]
+    n = len(cylinder_angles(p))
+    return ["main"] + [f"{k}_{i}" for i in range(1, n + 1) for k in ("big_end", "small_end")]
+
+
+def cylinder_angles(p) -> list[float]:
+    a = p["crank_train"]["cylinder_angles_deg"]
+    if a is not None:
+        return a
+    return [0.0] if p["mechanism"] == "slider_crank" else [90.0, 270.0, 0.0, 180.0]
+
+
+def _cross_checks(p):
+    if p["from_mechanism"]:
+        if p["mechanism"] == "four_bar":
+            raise SceneError("dynamics.from_mechanism: only crank trains (slider_crank, four_star) "
+                             "come from [mechanism]")
+    elif p["speed_rpm"] is None:
+        raise SceneError("dynamics.speed_rpm: is required (crank speed, rpm, > 0) unless "
+                         "from_mechanism = true")
+    ct = p["crank_train"]
+    if p["mechanism"] != "four_bar" and not p["from_mechanism"]:
+        if ct["crank_radius"] >= ct["rod_length"] - abs(ct["offset"]):
+            raise SceneError("dynamics.crank_train.rod_length: must exceed crank_radius + |offset| "
+                             f"= {ct['crank_radius'] + abs(ct['offset']):g} m")
+        if ct["row_z"] is not None and len(ct["row_z"]) != len(cylinder_angles(p)):
+            raise SceneError(f"dynamics.crank_train.row_z: needs one entry per cylinder "
+                             f"({len(cylinder_angles(p))})")
+        if p["mechanism"] == "slider_crank" and len(cylinder_angles(p)) != 1:
+            raise SceneError("dynamics.crank_train.cylinder_angles_deg: slider_crank has one "
+                             "cylinder; use mechanism = 'four_star' for several")
+    else:
+        l1, l2, l3 = p["four_bar"]["lengths"]
+        l0 = math.hypot(*p["four_bar"]["rocker_pivot"])
+        s = sorted([l0, l1, l2, l3])
+        if not (s[0] + s[3] <= s[1] + s[2] and min(s) == l1):
+            raise SceneError("dynamics.four_bar.lengths: not a crank-rocker (Grashof with the "
+                             "crank shortest) for the given rocker_pivot")
+    names = joint_names(p)
+    seen = set()
+    for i, c in enumerate(p["clearances"]):
+        if c["joint"] not in names:
+            raise SceneError(f"dynamics.clearances[{i}].joint: must be one of {', '.join(names)}; "
+                             f"got {c['joint']!r}")
+        if c["clearance_major"] is not None and c["clearance_major"] < c["clearance"]:
+            raise SceneError(f"dynamics.clearances[{i}].clearance_major: must be >= clearance "
+                             f"({c['clearance']:g} m)")
+        if c["viscosity"] is not None and c["bearing_length"] is None:
+            raise SceneError(f"dynamics.clearances[{i}].bearing_length: is required with "
+                             "viscosity (bearing length, m, > 0)")
+        if c["viscosity"] is not None and c["clearance_major"] is not None:
+            raise SceneError(f"dynamics.clearances[{i}].viscosity: the film model needs a round "
+                             "bore; remove clearance_major or viscosity")
+        if c["joint"] in seen:
+            raise SceneError(f"dynamics.clearances[{i}].joint: {c['joint']!r} given twice")
+        seen.add(c["joint"])
+    g, f = p["gas_force_deg"], p["gas_force_n"]
+    if (g is None) != (f is None):
+        raise SceneError("dynamics.gas_force_n: give both gas_force_deg and gas_force_n, or none")
+    if g is not None:
+        if len(g) != len(f) or len(g) < 2:
+            raise SceneError("dynamics.gas_force_n: needs as many entries as gas_force_deg (>= 2)")
+        if np.any(np.diff(g) <= 0) or g[0] < 0 or g[-1] > p["gas_cycle_deg"]:
+            raise SceneError("dynamics.gas_force_deg: must increase within [0, gas_cycle_deg]")
+    fr = p["friction"]
+    if fr["law"] != "none" and fr["v_dynamic"] <= fr["v_static"]:
+        raise SceneError("dynamics.friction.v_dynamic: must be > v_static "
+                         f"({fr['v_static']:g} m/s)")
+    if p["drive_torque"] is not None and p["mechanism"] != "four_bar" and ct["crank_inertia"] <= 0:
+        raise SceneError("dynamics.crank_train.crank_inertia: must be > 0 (crank and flywheel, "
+                         "kg m^2) when drive_torque sets the speed free")
+    if p["drive_torque"] is not None and p["ramp_time"] > 0:
+        raise SceneError("dynamics.ramp_time: must be 0 with drive_torque (the torque drives)")
+    if p["ramp_time"] >= p["end_time"] and p["ramp_time"] > 0:
+        raise SceneError(f"dynamics.ramp_time: must be < end_time ({p['end_time']:g} s)")

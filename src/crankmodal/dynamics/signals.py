@@ -1,0 +1,131 @@
+"""Signal post-processing: windowed spectra in Hz and engine orders, impacts, contact loss."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Spectrum:
+    """One-sided amplitude spectrum.
+
+    Attributes
+    ----------
+    frequency_hz : (F,) Hz.
+    order : (F,) frequency over the crank revolution frequency.
+    amplitude : (F,) or (F, C) amplitude of each harmonic, in the signal's unit (e.g. N).
+    """
+
+    frequency_hz: np.ndarray
+    order: np.ndarray
+    amplitude: np.ndarray
+
+    def at_orders(self, orders) -> np.ndarray:
+        """Amplitude at the bins nearest to the given engine orders."""
+        idx = [int(np.argmin(np.abs(self.order - k))) for k in orders]
+        return self.amplitude[idx]
+
+
+def amplitude_spectrum(t, x, revolution_hz, window="hann") -> Spectrum:
+    """Windowed FFT of a uniformly sampled signal.
+
+    Parameters
+    ----------
+    t : (K,) s, uniform spacing.
+    x : (K,) or (K, C) signal.
+    revolution_hz : float
+        Crank revolution frequency, Hz (for the order axis).
+    window : {"hann", "rect"}
+        The Hann window is amplitude-corrected (coherent gain): a sinusoid that falls on a bin
+        reads its amplitude; use an integer number of revolutions for exact order lines.
+    """
+    t = np.asarray(t, float)
+    x = np.asarray(x, float)
+    K = t.size
+    dt = (t[-1] - t[0]) / (K - 1)
+    w = np.hanning(K) if window == "hann" else np.ones(K)
+    w = w.reshape((K,) + (1,) * (x.ndim - 1))
+    X = np.fft.rfft((x - x.mean(axis=0)) * w, axis=0)
+    amp = 2.0 * np.abs(X) / w.sum()
+    amp[0] = np.abs(x.mean(axis=0))
+    f = np.fft.rfftfreq(K, dt)
+    return Spectrum(frequency_hz=f, order=f / revolution_hz, amplitude=amp)
+
+
+def order_amplitudes(t, x, revolution_hz, orders) -> np.ndarray:
+    """Exact Fourier amplitudes at integer orders from a whole number of revolutions.
+
+    ``t`` must span an integer number of revolutions (uniform, endpoint excluded or included:
+    the last sample is dropped if it closes the period).
+    """
+    t = np.asarray(t, float)
+    x = np.asarray(x, float)
+    period = 1.0 / revolution_hz
+    span = t[-1] - t[0]
+    if abs(span / period - round(span / period)) < 1e-6 and round(span / period) >= 1:
+        t, x = t[:-1], x[:-1]
+    phase = 2.0 * np.pi * revolution_hz * (t - t[0])
+    out = []
+    for k in orders:
+        c = np.exp(-1j * k * phase)
+        c = c.reshape((-1,) + (1,) * (x.ndim - 1))
+        out.append(2.0 * np.abs((x * c).mean(axis=0)) if k else np.abs(x.mean(axis=0)))
+    return np.array(out)
+
+
+def whirl_components(t, fx, fy, revolution_hz, order):
+    """Forward and backward whirl amplitudes of a planar force at one order, N.
+
+    ``fx + i fy = A_f exp(i k w t) + A_b exp(-i k w t) + ...``; a force of constant magnitude
+    rotating with the crank has ``A_b = 0``.
+    """
+    z = np.asarray(fx) + 1j * np.asarray(fy)
+    t = np.asarray(t, float)
+    period = 1.0 / revolution_hz
+    if abs((t[-1] - t[0]) / period - round((t[-1] - t[0]) / period)) < 1e-6:
+        t, z = t[:-1], z[:-1]
+    ph = 2.0 * np.pi * revolution_hz * (t - t[0])
+    return (abs(np.mean(z * np.exp(-1j * order * ph))),
+            abs(np.mean(z * np.exp(1j * order * ph))))
+
+
+def impact_statistics(onsets) -> dict:
+    """Count and velocities of the contact onsets ``[(t, v_impact)]`` of one joint."""
+    v = np.array([o[1] for o in onsets], float)
+    return {
+        "impact_count": int(v.size),
+        "impact_velocity_max": float(v.max()) if v.size else 0.0,
+        "impact_velocity_mean": float(v.mean()) if v.size else 0.0,
+        "impact_velocity_rms": float(np.sqrt(np.mean(v**2))) if v.size else 0.0,
+    }
+
+
+def force_direction(t, f) -> tuple[np.ndarray, np.ndarray]:
+    """Direction angle (rad, unwrapped) of a planar force and its rate (rad/s)."""
+    beta = np.unwrap(np.arctan2(f[:, 1], f[:, 0]))
+    return beta, np.gradient(beta, t)
+
+
+def contact_loss_indicator(t, f_ideal, crank_angle=None) -> dict:
+    """Seed 001's empirical criterion from the zero-clearance bearing force.
+
+    Contact is expected to be kept while the rate of change of the force direction (rad/s) over
+    the smallest force magnitude (N) stays below one: ``max|d beta/dt| / min|F| < 1``.
+    Returns the ratio (None if the force vanishes), where the direction changes fastest, and the
+    minimum force; with ``crank_angle`` (rad) also the crank angles (deg, 0..360) of both.
+    """
+    _, rate = force_direction(t, f_ideal)
+    mag = np.hypot(f_ideal[:, 0], f_ideal[:, 1])
+    k = int(np.argmax(np.abs(rate)))
+    fmin = float(mag.min())
+    ratio = float(np.abs(rate).max() / fmin) if fmin > 0.0 else None
+    kmin = int(np.argmin(mag))
+    out = {"ratio": ratio, "max_direction_rate": float(np.abs(rate[k])),
+           "time_of_max_rate": float(t[k]), "min_force": fmin, "time_of_min_force": float(t[kmin]),
+           "contact_kept": ratio is not None and ratio < 1.0}
+    if crank_angle is not None:
+        out["crank_angle_of_max_rate_deg"] = float(np.degrees(crank_angle[k]) % 360.0)
+        out["crank_angle_of_min_force_deg"] = float(np.degrees(crank_angle[kmin]) % 360.0)
+    return out

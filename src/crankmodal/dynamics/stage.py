@@ -1,0 +1,159 @@
+"""Scene stage ``[dynamics]``: crank-linkage dynamics with clearance joints.
+
+Runs the mechanism with its clearance joints (and, by default, its ideal-joint twin as the
+reference), writes ``dynamics.npz`` with every time history, PNG figures, and returns the summary
+numbers: peaks, impact statistics, main-bearing force per order, drive torque and power, the
+energy balance and the seed-001 contact-loss indicator.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+SECTION = "dynamics"
+REQUIRES = ()
+
+
+def validate(raw: dict, scene) -> dict:
+    from ..errors import SceneError
+    from .scene_keys import validate_section
+
+    p = validate_section(raw)
+    if p["from_mechanism"] and (scene is None or "mechanism" not in scene.sections):
+        raise SceneError("dynamics.from_mechanism: needs a [mechanism] section in the scene")
+    return p
+
+
+def _window(hist, p, rev_hz):
+    """Sample mask of the spectrum window: a whole number of revolutions after the start-up."""
+    t0 = p["spectrum_start"]
+    if t0 is None:
+        t0 = p["ramp_time"] + 1.0 / rev_hz
+        if t0 >= hist.t[-1] - 1.0 / rev_hz:
+            t0 = p["ramp_time"]
+    n_rev = int(np.floor((hist.t[-1] - t0) * rev_hz + 1e-9))
+    t1 = t0 + n_rev / rev_hz if n_rev >= 1 else hist.t[-1]
+    return (hist.t >= t0 - 1e-12) & (hist.t <= t1 + 1e-12), n_rev
+
+
+def run(params: dict, ctx) -> dict:
+    from .analysis import key_outputs, simulate, tolerance_study
+    from .build import build_mechanism, solver_settings
+    from .signals import (
+        amplitude_spectrum,
+        contact_loss_indicator,
+        force_direction,
+        impact_statistics,
+        order_amplitudes,
+    )
+
+    p = params
+    mech = build_mechanism(p, ctx.params.get("mechanism"))
+    rev_hz = mech.revolution_hz
+    settings = solver_settings(p, 60.0 * rev_hz)
+    dt = p["output_step"] or 1.0 / (360.0 * rev_hz)
+    t_end = p["end_time"]
+    tol = p["energy_tolerance"]
+    hist = simulate(mech, t_end, dt, settings, energy_tolerance=tol)
+    ideal = None
+    if p["run_ideal"] and mech.system.clearances:
+        ideal = simulate(mech, t_end, dt, settings, ideal=True, energy_tolerance=tol)
+    sel, n_rev = _window(hist, p, rev_hz)
+    orders = list(range(13))
+    res = {"mechanism": mech.kind, "speed_rpm": 60.0 * rev_hz, "revolution_hz": rev_hz,
+           "end_time_s": t_end, "output_step_s": dt, "rhs_evals": hist.nfev,
+           "integration_wall_time_s": hist.wall_time}
+    f = hist.main_bearing_force
+    res["main_bearing_force_peak_n"] = float(np.max(np.hypot(f[:, 0], f[:, 1])))
+    mm = hist.main_bearing_moment
+    res["main_bearing_moment_peak_nm"] = float(np.max(np.hypot(mm[:, 0], mm[:, 1])))
+    if n_rev >= 1:
+        amps = order_amplitudes(hist.t[sel], f[sel], rev_hz, orders)
+        res["main_bearing_orders"] = orders
+        res["main_bearing_order_amplitude_n"] = amps.tolist()  # rows: order; columns: x, y
+    res["piston_acceleration_peak"] = np.max(np.abs(hist.piston_acceleration), axis=0).tolist() \
+        if hist.piston_acceleration.size else []
+    res["angular_acceleration_peak"] = {name: float(np.max(np.abs(v[sel])))
+                                        for name, v in hist.angular_acceleration.items()}
+    res["drive_torque_peak_nm"] = float(np.max(np.abs(hist.drive_torque[sel])))
+    res["drive_power_mean_w"] = float(np.mean(hist.drive_power[sel]))
+    res["drive_power_peak_w"] = float(np.max(np.abs(hist.drive_power[sel])))
+    res["energy"] = {k: float(v[-1]) for k, v in hist.energy.items()}
+    res["energy_balance_error"] = hist.energy_error()
+    res["constraint_drift_max"] = float(hist.constraint_drift.max())
+    joints = {}
+    for cj in mech.system.clearances:
+        d = hist.contact[cj.name]
+        j = {"clearance_m": cj.clearance, "law": cj.law,
+             "stiffness": float(cj.law_params["stiffness"]),
+             "peak_contact_force_n": float(d["fn"].max()),
+             "max_penetration_m": float(max(d["penetration"].max(), 0.0)),
+             "contact_fraction": float(np.mean(d["penetration"][sel] > 0.0))}
+        j.update(impact_statistics(hist.onsets[cj.name]))
+        if ideal is not None:
+            j["contact_loss"] = contact_loss_indicator(ideal.t[sel], ideal.joint_forces[cj.name][sel],
+                                                       ideal.crank_angle[sel])
+        joints[cj.name] = j
+    res["clearance_joints"] = joints
+    if ideal is not None:
+        res["ideal"] = {"main_bearing_force_peak_n": float(np.max(np.hypot(
+            ideal.main_bearing_force[:, 0], ideal.main_bearing_force[:, 1]))),
+            "piston_acceleration_peak": np.max(np.abs(ideal.piston_acceleration), axis=0).tolist()
+            if ideal.piston_acceleration.size else [],
+            "drive_power_mean_w": float(np.mean(ideal.drive_power[sel]))}
+    study = None
+    if p["solver"]["study_rtols"]:
+        rt = sorted(set(p["solver"]["study_rtols"]) | {settings.rtol / 10})
+        study = tolerance_study(mech, t_end, dt, rt, t_start=float(hist.t[sel][0]), base=settings)
+        res["tolerance_study"] = study
+    arrays = hist.arrays()
+    if ideal is not None:
+        arrays.update({f"ideal_{k}": v for k, v in ideal.arrays().items()})
+        for cj in mech.system.clearances:
+            beta, rate = force_direction(ideal.t, ideal.joint_forces[cj.name])
+            arrays[f"ideal_force_direction_{cj.name}"] = beta
+            arrays[f"ideal_force_direction_rate_{cj.name}"] = rate
+    if n_rev >= 1:
+        spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev_hz)
+        arrays["spectrum_frequency_hz"] = spec.frequency_hz
+        arrays["spectrum_order"] = spec.order
+        arrays["spectrum_main_bearing_amplitude"] = spec.amplitude
+    out = ctx.out_dir
+    np.savez_compressed(out / "dynamics.npz", **arrays)
+    res["arrays"] = "dynamics.npz"
+    if ctx.figures:
+        res["figures"] = _figures(hist, ideal, mech, sel, study, out)
+    k = key_outputs(hist, rev_hz, float(hist.t[sel][0]))
+    n_imp = sum(j["impact_count"] for j in joints.values())
+    if mech.pistons:
+        motion = f"piston accel peak {k['peak_piston_acceleration']:.4g} m/s^2"
+    else:
+        motion = f"rocker accel peak {res['angular_acceleration_peak'].get('rocker', 0.0):.4g} rad/s^2"
+    res["summary"] = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {t_end:g} s: main-bearing peak "
+                      f"{res['main_bearing_force_peak_n']:.4g} N, {motion}, {n_imp} impacts, "
+                      f"energy balance {res['energy_balance_error']:.1e}")
+    ctx.products[SECTION] = {"mechanism": mech, "history": hist, "ideal": ideal}
+    return res
+
+
+def _figures(hist, ideal, mech, sel, study, out):
+    from . import plots
+    from .signals import amplitude_spectrum
+
+    figs = []
+    rev = mech.revolution_hz
+    spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev)
+    ispec = None if ideal is None else amplitude_spectrum(ideal.t[sel],
+                                                          ideal.main_bearing_force[sel], rev)
+    figs.append(plots.plot_bearing_force(hist, spec, out / "dynamics_main_bearing.png", ispec))
+    if hist.piston_acceleration.shape[1]:
+        figs.append(plots.plot_piston(hist, ideal, out / "dynamics_piston.png"))
+    if mech.system.clearances:
+        cl = {cj.name: cj.clearance for cj in mech.system.clearances}
+        figs.append(plots.plot_orbit(hist, cl, out / "dynamics_orbit.png"))
+        figs.append(plots.plot_contact(hist, out / "dynamics_contact.png"))
+    figs.append(plots.plot_drive(hist, ideal, out / "dynamics_drive.png"))
+    figs.append(plots.plot_energy(hist, out / "dynamics_energy.png"))
+    if study is not None:
+        figs.append(plots.plot_study(study, out / "dynamics_tolerance_study.png"))
+    return [f.name for f in figs]

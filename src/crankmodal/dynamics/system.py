@@ -1,0 +1,266 @@
+"""Assembly of bodies, constraints, clearance joints and loads into an index-1 DAE.
+
+Equations of motion in body coordinates ``q`` with Lagrange multipliers ``lam``::
+
+    [ M    Phi_q^T ] [ qdd ]   [ Q                                   ]
+    [ Phi_q   0    ] [ lam ] = [ gamma - 2 a Phidot - b**2 Phi        ]
+
+(Baumgarte stabilisation with ``a = b = baumgarte`` in 1/s). The ODE state is
+``y = [q, qd, W_drive, W_loads, W_constraints, D_contact, D_friction]``: the last five are the
+running integrals (J) of the drive power, the power of applied loads, the power of the ideal
+constraint forces (zero up to drift), and the power dissipated by contact damping and by friction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import fastpath
+from .bodies import Ground, RigidBody
+from .joints import AngleDrive
+
+N_AUX = 5
+_NO_JACOBIAN = np.zeros((3, 0))
+AUX_NAMES = ("work_drive", "work_loads", "work_constraints", "dissipated_contact",
+             "dissipated_friction")
+
+
+class Multibody:
+    """A planar multibody system.
+
+    Parameters
+    ----------
+    bodies : list
+        Bodies with coordinates (a :class:`~.bodies.Ground` is referenced by joints, not listed).
+    constraints : list
+        Ideal joints and drives (objects with ``n_eq`` and ``blocks``).
+    clearances : list of ClearanceJoint
+    loads : list
+        Objects with ``forces(sysm, t, q, qd, Q) -> power``.
+    gravity : (2,) array
+        m/s^2.
+    baumgarte : float
+        Stabilisation rate, 1/s.
+    """
+
+    def __init__(self, bodies, constraints, clearances=(), loads=(), gravity=(0.0, 0.0),
+                 baumgarte=100.0):
+        self.bodies = list(bodies)
+        self.constraints = list(constraints)
+        self.clearances = list(clearances)
+        self.loads = list(loads)
+        self.gravity = np.asarray(gravity, float)
+        self.baumgarte = float(baumgarte)
+        self.slices = {}
+        i = 0
+        for b in self.bodies:
+            self.slices[id(b)] = slice(i, i + b.ndof)
+            i += b.ndof
+        self.n = i
+        self.rows = []
+        j = 0
+        for c in self.constraints:
+            self.rows.append(slice(j, j + c.n_eq))
+            j += c.n_eq
+        self.m = j
+        self._kkt = np.zeros((self.n + self.m, self.n + self.m))
+        self._rigid = all(hasattr(b, "inertia") for b in self.bodies)
+        if self._rigid:
+            self._kkt[: self.n, : self.n] = self.mass_matrix(np.zeros(self.n))
+        self.nfev = 0
+        self.max_nfev = None
+        self._cache = None
+        self._register_frames()
+        self._table = fastpath.RigidConstraintTable(self) if fastpath.applicable(self) else None
+        self._drive_rows = np.zeros(self.m, bool)
+        for c, r in zip(self.constraints, self.rows):
+            self._drive_rows[r] = isinstance(c, AngleDrive)
+
+    # ----------------------------------------------------------------- body access
+    def body_q(self, body, q):
+        return q[self.slices[id(body)]]
+
+    def frame(self, body, frame, q, qd):
+        """Pose, Jacobian (3, ndof_body) and ``Jdot qdot`` of an interface frame."""
+        if isinstance(body, Ground):
+            return body.frame_pose(None, frame), _NO_JACOBIAN, np.zeros(3)
+        cache = self._cache
+        if cache is not None and cache[0] is q:
+            k = self._frame_index.get((id(body), frame))
+            if k is not None:
+                return cache[1][k], cache[2][k], cache[3][k]
+        s = self.slices[id(body)]
+        return (body.frame_pose(q[s], frame), body.frame_jacobian(q[s], frame),
+                body.frame_bias(q[s], qd[s], frame))
+
+    def _register_frames(self):
+        """Index the rigid-body frames used by joints and loads for vectorised evaluation."""
+        self._frame_index = {}
+        ib, loc = [], []
+        for b in self.bodies:
+            if not isinstance(b, RigidBody):
+                continue
+            for name in b.frames:
+                s, phi = b.local(name)
+                self._frame_index[(id(b), name)] = len(ib)
+                ib.append(self.slices[id(b)].start)
+                loc.append((s[0], s[1], phi))
+        self._fi = np.array(ib, int)
+        self._floc = np.array(loc, float).reshape(-1, 3)
+
+    def _fill_cache(self, q, qd):
+        self._cache = self._frame_table(q, qd)
+        return self._cache
+
+    def _frame_table(self, q, qd):
+        """Poses, Jacobians, ``Jdot qdot`` and rotated offsets of all rigid frames (pure)."""
+        i, L = self._fi, self._floc
+        th = q[i + 2]
+        c, sn = np.cos(th), np.sin(th)
+        ax = c * L[:, 0] - sn * L[:, 1]
+        ay = sn * L[:, 0] + c * L[:, 1]
+        k = len(i)
+        pose = np.column_stack([q[i] + ax, q[i + 1] + ay, th + L[:, 2]])
+        J = np.zeros((k, 3, 3))
+        J[:, 0, 0] = J[:, 1, 1] = J[:, 2, 2] = 1.0
+        J[:, 0, 2] = -ay
+        J[:, 1, 2] = ax
+        w2 = qd[i + 2] ** 2
+        bias = np.column_stack([-w2 * ax, -w2 * ay, np.zeros(k)])
+        return (q, pose, J, bias, np.column_stack([ax, ay]))
+
+    def frame_pose_only(self, body, frame, q):
+        if isinstance(body, Ground):
+            return body.frame_pose(None, frame)
+        return body.frame_pose(q[self.slices[id(body)]], frame)
+
+    def frame_velocity(self, body, J, qd):
+        """Frame velocity ``(vx, vy, omega)`` from its Jacobian."""
+        if J is _NO_JACOBIAN:
+            return np.zeros(3)
+        return J @ qd[self.slices[id(body)]]
+
+    def add_frame_force(self, Q, body, J, f):
+        """Add a force/moment ``(fx, fy, mz)`` acting at an interface frame to ``Q``."""
+        if J is not _NO_JACOBIAN:
+            Q[self.slices[id(body)]] += J.T @ f
+
+    # ----------------------------------------------------------------- global quantities
+    def mass_matrix(self, q):
+        M = np.zeros((self.n, self.n))
+        for b in self.bodies:
+            s = self.slices[id(b)]
+            M[s, s] = b.mass_matrix(q[s])
+        return M
+
+    def constraint_terms(self, t, q, qd):
+        """``Phi``, ``Phi_q`` (m, n), ``nu = -Phi_t`` and ``gamma``."""
+        if self._table is not None:
+            c = self._cache
+            if c is None or c[0] is not q:
+                c = self._frame_table(q, qd)
+            return self._table.terms(t, c[1], c[4], c[3])
+        return self.generic_constraint_terms(t, q, qd)
+
+    def generic_constraint_terms(self, t, q, qd):
+        """Constraint terms joint by joint (any body type)."""
+        phi = np.empty(self.m)
+        Cq = np.zeros((self.m, self.n))
+        nu = np.empty(self.m)
+        gamma = np.empty(self.m)
+        for c, r in zip(self.constraints, self.rows):
+            ph, blocks, nn, gg = c.blocks(self, t, q, qd)
+            phi[r], nu[r], gamma[r] = ph, nn, gg
+            for body, J in blocks:
+                if not isinstance(body, Ground):
+                    Cq[r, self.slices[id(body)]] += J
+        return phi, Cq, nu, gamma
+
+    def energy(self, q, qd):
+        """Kinetic and gravitational potential energy, J."""
+        ke = pe = 0.0
+        for b in self.bodies:
+            s = self.slices[id(b)]
+            ke += b.kinetic_energy(q[s], qd[s])
+            pe += b.potential_energy(q[s], self.gravity)
+        return ke, pe
+
+    def solve(self, t, q, qd):
+        """Accelerations, multipliers and per-element diagnostics at one state."""
+        n = self.n
+        self._fill_cache(q, qd)
+        Q = np.zeros(n)
+        for b in self.bodies:
+            s = self.slices[id(b)]
+            Q[s] += b.gravity_force(q[s], self.gravity) + b.velocity_forces(q[s], qd[s])
+        contacts = [cj.forces(self, t, q, qd, Q) for cj in self.clearances]
+        p_loads = sum(ld.forces(self, t, q, qd, Q) for ld in self.loads)
+        phi, Cq, nu, gamma = self.constraint_terms(t, q, qd)
+        a = self.baumgarte
+        phidot = Cq @ qd - nu
+        rhs = np.concatenate([Q, gamma - 2.0 * a * phidot - a * a * phi])
+        K = self._kkt
+        if not self._rigid:
+            K[:n, :n] = self.mass_matrix(q)
+        K[:n, n:] = Cq.T
+        K[n:, :n] = Cq
+        sol = np.linalg.solve(K, rhs)
+        self._cache = None
+        qdd, lam = sol[:n], sol[n:]
+        return dict(qdd=qdd, lam=lam, phi=phi, Cq=Cq, nu=nu, contacts=contacts,
+                    p_loads=p_loads)
+
+    def drive_power(self, lam, Cq, qd):
+        """Power of the rheonomic (drive) constraints and of the ideal joints, W."""
+        p = -lam * (Cq @ qd)
+        p_drive = float(p[self._drive_rows].sum())
+        return p_drive, float(p.sum()) - p_drive
+
+    def rhs(self, t, y):
+        """Right-hand side of the first-order ODE in ``y``."""
+        self.nfev += 1
+        if self.max_nfev is not None and self.nfev > self.max_nfev:
+            raise BudgetExceeded(t)
+        n = self.n
+        q, qd = y[:n], y[n: 2 * n]
+        out = self.solve(t, q, qd)
+        p_drive, p_ideal = self.drive_power(out["lam"], out["Cq"], qd)
+        p_damp = sum(c["p_damp"] for c in out["contacts"])
+        p_fric = sum(c["p_fric"] for c in out["contacts"])
+        dy = np.concatenate([qd, out["qdd"], [p_drive, out["p_loads"], p_ideal, p_damp, p_fric]])
+        if not np.all(np.isfinite(dy)):
+            raise NonFinite(t)
+        return dy
+
+    # ----------------------------------------------------------------- initial state
+    def assemble(self, t, q0, qd0, tol=1e-12, max_iter=30):
+        """Consistent positions and velocities close to ``q0``, ``qd0`` (least-change Newton)."""
+        q = np.array(q0, float)
+        for _ in range(max_iter):
+            phi, Cq, nu, _ = self.constraint_terms(t, q, np.zeros(self.n))
+            if np.max(np.abs(phi), initial=0.0) < tol:
+                break
+            q -= np.linalg.lstsq(Cq, phi, rcond=None)[0]
+        else:
+            raise RuntimeError("assembly did not converge")
+        _, Cq, nu, _ = self.constraint_terms(t, q, np.zeros(self.n))
+        qd = np.array(qd0, float)
+        if self.m:
+            qd -= np.linalg.lstsq(Cq, Cq @ qd - nu, rcond=None)[0]
+        return q, qd
+
+
+class BudgetExceeded(Exception):
+    """The right-hand side was evaluated more often than allowed."""
+
+    def __init__(self, t):
+        super().__init__(t)
+        self.t = t
+
+
+class NonFinite(Exception):
+    """The right-hand side produced NaN or inf."""
+
+    def __init__(self, t):
+        super().__init__(t)
+        self.t = t

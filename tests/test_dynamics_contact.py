@@ -1,0 +1,168 @@
+"""Contact laws of the clearance joint against closed-form impact results.
+
+A free journal (no gravity, no friction) starts at the centre of a fixed bearing and flies
+radially into the wall. Away from the wall no force acts, so the speed at which it reaches the
+opposite wall is its rebound speed; the ratio to the first impact speed is the coefficient of
+restitution the law produces.
+"""
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from crankmodal.dynamics import contact
+from crankmodal.dynamics.bodies import Ground, RigidBody
+from crankmodal.dynamics.clearance import ClearanceJoint
+from crankmodal.dynamics.simulate import SolverSettings, integrate
+from crankmodal.dynamics.system import Multibody
+
+MASS = 2.0
+CLEARANCE = 1e-4
+
+
+def _journal_in_bearing(law, params, friction="none", friction_params=None, spin=0.0, vy=0.0):
+    ground = Ground(frames={"bore": (0.0, 0.0)})
+    journal = RigidBody("journal", MASS, 1e-3, {"centre": (0.0, 0.0)})
+    joint = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=CLEARANCE,
+                           journal_radius=0.01, law=law, law_params=params, friction=friction,
+                           friction_params=friction_params or {})
+    sysm = Multibody([journal], [], [joint])
+    return sysm, joint
+
+
+def _first_two_impacts(law, params, v0=1.0, t_end=3e-3):
+    sysm, _ = _journal_in_bearing(law, params)
+    out = integrate(sysm, np.zeros(3), np.array([v0, 0.0, 0.0]), t_end, None,
+                    SolverSettings(rtol=1e-9, atol=1e-13))
+    onsets = out.onsets[0]
+    return onsets, out.separations[0]
+
+
+def _hunt_crossley_exact_restitution(a):
+    """Root of  a (1 + e) = -ln((1 - a e) / (1 + a)),  a = chi v0, from m v dv = -K d^n (1 + chi v) dd."""
+    return brentq(lambda e: a * (1.0 + e) + np.log((1.0 - a * e) / (1.0 + a)), 1e-12,
+                  min(1.0, 1.0 / a - 1e-12) if a > 1 else 1.0)
+
+
+@pytest.mark.parametrize("law", ["hunt_crossley", "lankarani_nikravesh", "flores"])
+@pytest.mark.parametrize("e", [0.3, 0.9])
+def test_hysteresis_law_rebound_matches_exact_energy_integral(law, e):
+    # Oracle: for F = K d^n (1 + chi d'), the phase-plane integral gives e_out independent of K, n.
+    v0 = 1.0
+    a = float(contact.hysteresis_factor(law, e, v0)) * v0
+    expected = _hunt_crossley_exact_restitution(a)
+    onsets, _ = _first_two_impacts(law, {"stiffness": 1e10, "exponent": 1.5, "restitution": e}, v0)
+    assert len(onsets) >= 2
+    assert onsets[0][1] == pytest.approx(v0, rel=1e-6)  # event located on the dense output
+    assert onsets[1][1] / v0 == pytest.approx(expected, rel=2e-5)
+
+
+def test_lankarani_nikravesh_gives_its_restitution_for_hard_impacts():
+    # LN (1990) is derived for e near 1: e = 0.9 requested, 0.9 delivered within 1.5 %.
+    onsets, _ = _first_two_impacts("lankarani_nikravesh",
+                                   {"stiffness": 1e10, "exponent": 1.5, "restitution": 0.9})
+    assert onsets[1][1] == pytest.approx(0.9, rel=0.015)
+
+
+def test_flores_law_gives_its_restitution_over_a_wide_range():
+    # Flores et al. (2011) target the whole range: e = 0.5 requested, exact integral 0.47 (6 %).
+    onsets, _ = _first_two_impacts("flores", {"stiffness": 1e10, "exponent": 1.5,
+                                              "restitution": 0.5})
+    assert onsets[1][1] == pytest.approx(0.5, rel=0.12)
+
+
+def test_hertz_impact_is_elastic_and_lasts_the_hertz_contact_time():
+    # Oracle: Hertz (n = 3/2) contact time 2.9432 d_max / v0, d_max = (5 m v0^2 / 4 K)^(2/5).
+    K, v0 = 1e10, 1.0
+    onsets, seps = _first_two_impacts("hertz", {"stiffness": K, "exponent": 1.5}, v0)
+    d_max = (2.5 * MASS * v0**2 / (2 * K)) ** 0.4
+    assert onsets[1][1] == pytest.approx(v0, rel=1e-6)
+    assert seps[0] - onsets[0][0] == pytest.approx(2.9432 * d_max / v0, rel=1e-4)
+
+
+def test_impact_law_damping_ramp_is_continuous_and_dissipative():
+    # ADAMS IMPACT: no damping force at first touch (STEP starts at 0), full damping beyond d_max.
+    p = dict(K=1e8, n=1.5, c_max=100.0, d_max=1e-4)
+    assert contact.impact(1e-12, 1.0, **p) == pytest.approx(0.0, abs=1e-6)
+    deep = contact.impact(2e-4, 1.0, **p)
+    assert deep == pytest.approx(1e8 * 2e-4**1.5 + 100.0)
+    onsets, _ = _first_two_impacts("impact", {"stiffness": 1e10, "exponent": 1.5, "damping": 2000.0,
+                                              "penetration": 1e-5})
+    assert 0.0 < onsets[1][1] < 1.0
+
+
+def test_coulomb_transition_and_ambrosio_law_are_odd_and_reach_their_coefficients():
+    v = np.array([-1.0, -0.02, -1e-4, 0.0, 1e-4, 0.02, 1.0])
+    mu = contact.coulomb_coefficient(v, mu_s=0.3, mu_d=0.1, v_s=1e-4, v_d=1e-2)
+    np.testing.assert_allclose(mu, -mu[::-1])
+    assert mu[3] == 0.0 and mu[4] == pytest.approx(0.3) and mu[5] == pytest.approx(0.1)
+    amb = contact.ambrosio_coefficient(v, mu_d=0.1, v0=1e-4, v1=1e-2)
+    assert amb[4] == 0.0 and amb[5] == pytest.approx(0.1) and amb[2] == 0.0
+
+
+@pytest.mark.parametrize("friction", ["coulomb", "ambrosio"])
+def test_spinning_journal_friction_energy_is_booked(friction):
+    # A journal thrown off-centre with spin rubs the wall: kinetic energy lost = contact damping
+    # + friction dissipation (energy balance closes), and friction does take energy out.
+    sysm, _ = _journal_in_bearing("lankarani_nikravesh",
+                                  {"stiffness": 1e9, "exponent": 1.5, "restitution": 0.7},
+                                  friction, {"mu_static": 0.2, "mu_dynamic": 0.15,
+                                             "v_static": 1e-4, "v_dynamic": 1e-2})
+    y = integrate(sysm, np.zeros(3), np.array([0.5, 0.2, 200.0]), 4e-3, None,
+                  SolverSettings(rtol=1e-8, atol=1e-13)).y
+    ke0 = sysm.energy(np.zeros(3), np.array([0.5, 0.2, 200.0]))[0]
+    ke, _ = sysm.energy(y[:3, -1], y[3:6, -1])
+    el = sum(float(contact.elastic_energy(cj.law, cj.gap(sysm, y[:3, -1]), cj.law_params))
+             for cj in sysm.clearances)
+    d_contact, d_friction = y[-2, -1], y[-1, -1]
+    assert d_friction > 1e-3 * ke0
+    assert ke + el - ke0 == pytest.approx(-(d_contact + d_friction), abs=1e-6 * ke0)
+
+
+def test_cylinder_stiffness_grows_as_the_clearance_closes():
+    # K ~ sqrt(R_i R_j / (R_j - R_i)): quartering the clearance doubles the stiffness.
+    k1 = contact.cylinder_stiffness(0.02, 0.02 + 1e-4, 2.1e11, 0.3, 2.1e11, 0.3)
+    k2 = contact.cylinder_stiffness(0.02, 0.02 + 0.25e-4, 2.1e11, 0.3, 2.1e11, 0.3)
+    assert k2 / k1 == pytest.approx(2.0, rel=5e-3)  # R_j also shrinks slightly
+    # steel on steel, R = 20 mm, c = 0.1 mm: 4/(3 * 2 * 0.91 / 2.1e11) * sqrt(0.02 * 0.0201 / 1e-4)
+    assert k1 == pytest.approx(1.5385e11 * np.sqrt(0.02 * 0.0201 / 1e-4), rel=1e-3)
+
+
+@pytest.mark.parametrize("direction,axis_clearance", [((-1.0, 0.0), 1.4e-4), ((0.0, -1.0), 1e-4)])
+def test_worn_elliptical_bore_holds_a_loaded_journal_at_the_axis_clearance_plus_static_deflection(
+        direction, axis_clearance):
+    # Seed 003's worn bearing: bore semi-axes R + 0.14 mm (x) and R + 0.1 mm (y). A journal under
+    # a constant load along an axis settles at that axis' clearance + m g / K (linear law).
+    ground = Ground(frames={"bore": (0.0, 0.0)})
+    journal = RigidBody("journal", MASS, 1e-3, {"centre": (0.0, 0.0)})
+    K, g = 1e9, 2000.0
+    joint = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
+                           clearance_major=1.4e-4, journal_radius=0.01, law="kelvin_voigt",
+                           law_params={"stiffness": K, "damping": 3e4})
+    sysm = Multibody([journal], [], [joint], gravity=g * np.array(direction))
+    y = integrate(sysm, np.zeros(3), np.zeros(3), 0.03, None, SolverSettings(rtol=1e-7, atol=1e-12)).y
+    pos = y[:2, -1]
+    expected = (axis_clearance + MASS * g / K) * np.array(direction)
+    np.testing.assert_allclose(pos, expected, atol=1e-9)
+
+
+def test_worn_bore_contact_on_a_spinning_bearing_conserves_energy():
+    # Elastic (Hertz) contact in an elliptical bore that itself rotates: the force along the
+    # gradient of the penetration and the bearing moment make the contact conservative.
+    ground = Ground(frames={"o": (0.0, 0.0)})
+    ring = RigidBody("ring", 3.0, 2e-3, {"bore": (0.0, 0.0)})
+    journal = RigidBody("journal", MASS, 1e-3, {"centre": (0.0, 0.0)})
+    from crankmodal.dynamics.joints import Revolute
+
+    joint = ClearanceJoint("c", journal, "centre", ring, "bore", clearance=1e-4,
+                           clearance_major=4e-4, wear_angle=0.3, journal_radius=0.01,
+                           law="hertz", law_params={"stiffness": 1e10, "exponent": 1.5})
+    sysm = Multibody([ring, journal], [Revolute("pivot", ring, "bore", ground, "o")], [joint])
+    q0, qd0 = np.zeros(6), np.array([0.0, 0.0, 30.0, 0.4, 0.3, 0.0])
+    out = integrate(sysm, q0, qd0, 0.008, None, SolverSettings(rtol=1e-9, atol=1e-14))
+    y = out.y[:, -1]
+    ke0 = sysm.energy(q0, qd0)[0]
+    ke = sysm.energy(y[:6], y[6:12])[0]
+    el = float(contact.elastic_energy("hertz", joint.gap(sysm, y[:6]), joint.law_params))
+    assert len(out.onsets[0]) >= 2
+    assert ke + el == pytest.approx(ke0, rel=1e-6)

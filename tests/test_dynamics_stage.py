@@ -1,0 +1,97 @@
+"""The [dynamics] scene stage: validation messages, outputs on disk, machine defaults."""
+
+import json
+
+import numpy as np
+import pytest
+
+from crankmodal.errors import SceneError
+from crankmodal.runner import check, run
+from crankmodal.scene import scene_from_dict
+
+SMALL = {
+    "dynamics": {
+        "mechanism": "slider_crank", "speed_rpm": 3000.0, "end_time": 0.025,
+        "gas_force_deg": [0.0, 90.0, 180.0, 270.0, 360.0],
+        "gas_force_n": [3000.0, 500.0, 0.0, 500.0, 3000.0],
+        "crank_train": {"crank_radius": 0.035, "rod_length": 0.14},
+        "clearances": [{"joint": "big_end_1", "clearance": 1e-4, "journal_radius": 0.02}],
+        "contact": {"law": "lankarani_nikravesh", "stiffness": 1e10, "restitution": 0.8},
+        "friction": {"law": "coulomb"},
+        "solver": {},
+    }
+}
+
+
+def _scene(data):
+    return scene_from_dict(data, name="t")
+
+
+@pytest.mark.parametrize("path,value,needle", [
+    (("dynamics", "speed_rpm"), -5.0, "dynamics.speed_rpm: must be > 0"),
+    (("dynamics", "contact", "law"), "elastic", "dynamics.contact.law: must be one of"),
+    (("dynamics", "crank_train", "rod_length"), 0.03, "dynamics.crank_train.rod_length"),
+    (("dynamics", "clearances"), [{"joint": "big_end_7"}], "dynamics.clearances[0].joint"),
+    (("dynamics", "solver", "method"), "Euler", "dynamics.solver.method"),
+    (("dynamics", "friction", "v_dynamic"), 1e-5, "dynamics.friction.v_dynamic: must be > v_static"),
+])
+def test_bad_dynamics_value_names_its_key(path, value, needle):
+    import copy
+
+    data = copy.deepcopy(SMALL)
+    node = data
+    for k in path[:-1]:
+        node = node[k]
+    node[path[-1]] = value
+    with pytest.raises(SceneError) as exc:
+        check(_scene(data))
+    assert needle in str(exc.value)
+    assert "\n" not in str(exc.value)
+
+
+def test_from_mechanism_without_a_mechanism_section_is_refused():
+    data = {"dynamics": {"mechanism": "four_star", "from_mechanism": True}}
+    with pytest.raises(SceneError, match="needs a \\[mechanism\\] section"):
+        check(_scene(data))
+
+
+def test_dynamics_stage_writes_results_arrays_and_figures(tmp_path):
+    res = run(_scene(SMALL), tmp_path, figures=True)["dynamics"]
+    on_disk = json.loads((tmp_path / "results.json").read_text())["dynamics"]
+    assert on_disk["summary"] == res["summary"]
+    joint = res["clearance_joints"]["big_end_1"]
+    assert joint["impact_count"] >= 1 and joint["impact_velocity_max"] > 0
+    assert res["energy_balance_error"] < 1e-3
+    assert len(res["main_bearing_order_amplitude_n"]) == len(res["main_bearing_orders"])
+    arrays = np.load(tmp_path / "dynamics.npz")
+    for name in ("t", "piston_acceleration", "main_bearing_force", "drive_torque",
+                 "contact_big_end_1_fn", "impacts_big_end_1", "ideal_main_bearing_force"):
+        assert name in arrays and np.all(np.isfinite(arrays[name]))
+    for fig in res["figures"]:
+        assert (tmp_path / fig).stat().st_size > 1000
+
+
+def test_ideal_slider_crank_main_bearing_orders_match_the_mechanism_inertia_law(tmp_path):
+    # No gas, ideal joints, massless rod and crank: the frame's x force is m_p times the piston
+    # acceleration, whose Fourier series is r w^2 (A1 cos + A2 cos 2 + ...) with A1 = 1 and
+    # A2 = lambda + lambda^3/4 + 15 lambda^5/128 + ... (exact expansion of the slider-crank).
+    data = {"dynamics": {"mechanism": "slider_crank", "speed_rpm": 1500.0, "end_time": 0.08,
+                         "spectrum_start": 0.0, "run_ideal": False,
+                         "crank_train": {"crank_radius": 0.05, "rod_length": 0.2, "rod_mass": 1e-6,
+                                         "rod_inertia": 1e-9, "piston_mass": 2.0}}}
+    res = run(_scene(data), tmp_path, figures=False)["dynamics"]
+    amps = np.array(res["main_bearing_order_amplitude_n"])
+    w = 1500 * np.pi / 30
+    first = 2.0 * 0.05 * w**2
+    assert amps[1, 0] == pytest.approx(first, rel=1e-4)
+    lam = 0.25
+    assert amps[2, 0] == pytest.approx((lam + lam**3 / 4 + 15 * lam**5 / 128) * first, rel=1e-4)
+
+
+def test_machine_defaults_build_the_seed_loom_four_bar(tmp_path):
+    data = {"dynamics": {"machine": "loom_four_bar", "end_time": 0.02, "run_ideal": False}}
+    params = check(_scene(data))["dynamics"]
+    assert params["four_bar"]["lengths"] == [0.035, 0.075, 0.145]
+    assert params["clearances"][0]["clearance"] == pytest.approx(2.1e-5)
+    res = run(_scene(data), tmp_path, figures=False)["dynamics"]
+    assert res["mechanism"] == "four_bar" and res["energy_balance_error"] < 1e-3
