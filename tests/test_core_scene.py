@@ -70,3 +70,26 @@ def test_relative_files_resolve_against_the_scene_folder(tmp_path):
     scene = load_scene(p)
     assert scene.name == "x"
     assert scene.resolve("part.step") == tmp_path / "part.step"
+
+
+def test_override_reaches_into_a_machine_array_of_tables():
+    scene = scene_from_dict(
+        {"dynamics": {"machine": "four_star_compressor"}},
+        overrides=["dynamics.clearances.0.clearance=2e-4"],
+    )
+    clearances = scene.sections["dynamics"]["clearances"]
+    assert clearances[0]["clearance"] == 2e-4
+    assert "joint" in clearances[0]  # the rest of the machine's entry is kept
+
+
+def test_override_index_out_of_range_is_refused():
+    with pytest.raises(SceneError, match=r"dynamics\.clearances\.7 is not an entry"):
+        scene_from_dict({"dynamics": {"machine": "four_star_compressor"}},
+                        overrides=["dynamics.clearances.7.clearance=2e-4"])
+
+
+def test_override_of_the_machine_itself_selects_its_defaults():
+    scene = scene_from_dict({"mechanism": {"machine": "four_star_compressor"}},
+                            overrides=["mechanism.machine=slider_crank_engine"])
+    assert scene.sections["mechanism"]["machine"] == "slider_crank_engine"
+    assert len(scene.sections["mechanism"]["cylinders"]) == 1

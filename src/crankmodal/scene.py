@@ -71,7 +71,10 @@ def parse_value(text: str) -> Any:
 
 
 def apply_override(tables: dict, assignment: str) -> None:
-    """Apply one ``section.key[.sub]=value`` assignment in place."""
+    """Apply one ``section.key[.sub]=value`` assignment in place.
+
+    A numeric path element indexes an array of tables: ``dynamics.clearances.0.clearance=2e-4``.
+    """
     if "=" not in assignment:
         raise SceneError(f"--set {assignment!r}: expected section.key=value")
     dotted, _, text = assignment.partition("=")
@@ -79,12 +82,22 @@ def apply_override(tables: dict, assignment: str) -> None:
     if len(parts) < 2 or not all(parts):
         raise SceneError(f"--set {assignment!r}: expected section.key=value")
     node = tables
-    for p in parts[:-1]:
-        nxt = node.setdefault(p, {})
-        if not isinstance(nxt, dict):
-            raise SceneError(f"--set {dotted}: {p!r} is not a table")
-        node = nxt
-    node[parts[-1]] = parse_value(text.strip())
+    for i, p in enumerate(parts):
+        last = i == len(parts) - 1
+        where = ".".join(parts[: i + 1])
+        if isinstance(node, list):
+            if not p.isdigit() or int(p) >= len(node):
+                raise SceneError(f"--set {dotted}: {where} is not an entry of a {len(node)}-entry list")
+            p = int(p)
+        elif not isinstance(node, dict):
+            raise SceneError(f"--set {dotted}: {'.'.join(parts[:i])} is not a table")
+        if last:
+            node[p] = parse_value(text.strip())
+        else:
+            if isinstance(node, dict):
+                node = node.setdefault(p, {})
+            else:
+                node = node[p]
 
 
 def scene_from_dict(
@@ -96,8 +109,11 @@ def scene_from_dict(
 ) -> Scene:
     """Build a :class:`Scene` from a TOML-like dict (the programmatic entry point)."""
     data = copy.deepcopy(data)
+    # A machine named by --set must be known before its defaults are merged; every other
+    # override is applied on top of the merged tables, so it can reach into machine lists.
     for assignment in overrides:
-        apply_override(data, assignment)
+        if assignment.partition("=")[0].strip().endswith(".machine"):
+            apply_override(data, assignment)
     sections = {}
     for key, value in data.items():
         if key in TOP_LEVEL_KEYS:
@@ -109,6 +125,8 @@ def scene_from_dict(
                 f"{key}: unknown top-level key; a scene holds {', '.join(TOP_LEVEL_KEYS)} and sections"
             )
         sections[key] = with_machine_defaults(key, value)
+    for assignment in overrides:
+        apply_override(sections, assignment)
     return Scene(
         name=data.get("name", name),
         base_dir=Path(base_dir),
