@@ -50,7 +50,7 @@ def test_four_star_scene_reproduces_the_seed_balance_and_writes_its_outputs(tmp_
     assert res["first_order_force_max_n"] == pytest.approx(2 * ms * 0.035 * w**2, rel=1e-9)
     assert res["first_order_magnitude_constant"] and res["second_order_force_cancelled"]
     assert res["second_order_moment_max_nm"] == pytest.approx(
-        math.sqrt(10) * 0.03 * (0.035 / 0.392) * ms * 0.035 * w**2, rel=1e-9)
+        math.sqrt(10) * 0.016 * (0.035 / 0.392) * ms * 0.035 * w**2, rel=1e-9)
     # peak acceleration at TDC: r w^2 (1 + lambda), closed form
     # extreme accelerations r w^2 (1 +- lambda) at TDC/BDC (lambda < 1/4): seed Fig. 3's unequal
     # positive and negative maxima

@@ -1,0 +1,82 @@
+"""Build, tag and mesh a part from parameters: the one call most users need."""
+
+from __future__ import annotations
+
+from ..part import Part
+from .checks import check_conrod, check_crankshaft, check_fidelity
+from .massprops import cad_mass_properties, compare, mesh_mass_properties
+from .mesh import MeshSettings, detail_faces, generate, quality, set_sizes, to_meshio
+from .params import ConrodParams, CrankshaftParams
+from .regions import regions_from_mesh, tag_regions
+from .session import gmsh_session, quiet_stdout
+
+
+def _check_settings(settings: MeshSettings) -> None:
+    from ..errors import GeometryError
+
+    if not settings.size > 0:
+        raise GeometryError(f"geometry.mesh_size: must be > 0 m, got {settings.size!r}")
+    if settings.order not in (1, 2):
+        raise GeometryError(f"geometry.element_order: must be 1 or 2, got {settings.order!r}")
+    if not 0 < settings.refine <= 1:
+        raise GeometryError(f"geometry.refine: must be in (0, 1], got {settings.refine!r}")
+
+
+def build_part(params: CrankshaftParams | ConrodParams, fidelity: str, settings: MeshSettings,
+               name: str = "", step_file=None) -> Part:
+    """Make, mesh and name a crankshaft or connecting rod.
+
+    Parameters
+    ----------
+    params : CrankshaftParams or ConrodParams
+        Checked here before gmsh runs.
+    fidelity : str
+        ``full``, ``dechamfered`` or ``simplified``.
+    settings : MeshSettings
+        Mesh size (m), order, refinement.
+    name : str
+        Part name (default: the parameter type).
+    step_file : path, optional
+        Also write the CAD solid to this STEP file (metres).
+
+    Returns
+    -------
+    Part
+        With regions, CAD mass properties, and in ``quality`` the mesh statistics and the
+        mesh-vs-CAD mass-property differences (``mass_check``).
+    """
+    check_fidelity(fidelity)
+    _check_settings(settings)
+    if isinstance(params, CrankshaftParams):
+        check_crankshaft(params)
+        from .crankshaft import build_crankshaft as builder
+        kind = "crankshaft"
+    else:
+        check_conrod(params)
+        from .conrod import build_conrod as builder
+        kind = "rod"
+    described = {**params.to_dict(), "fidelity": fidelity, **settings.to_dict()}
+    with gmsh_session(f"{kind} ({fidelity})", described) as gmsh:
+        volumes, specs, detail = builder(gmsh, params, fidelity)
+        cad = cad_mass_properties(gmsh, volumes)
+        if step_file is not None:
+            gmsh.option.setString("Geometry.OCCTargetUnit", "M")  # the STEP file says metres
+            with quiet_stdout():  # OpenCASCADE's STEP writer prints its statistics
+                gmsh.write(str(step_file))
+        tagged = tag_regions(gmsh, specs)
+        gmsh.model.addPhysicalGroup(3, volumes, name="solid")
+        refined = sorted(set(detail_faces(gmsh, detail["radius"])) | set(detail["faces"]))
+        set_sizes(gmsh, settings, refined)
+        generate(gmsh, settings)
+        mesh, index = to_meshio(gmsh)
+        regions = regions_from_mesh(gmsh, tagged, specs, index)
+        stats = quality(gmsh, mesh)
+    try:
+        stats["mass_check"] = compare(cad, mesh_mass_properties(mesh.points, mesh.cells[0].data))
+    except ValueError as exc:
+        from ..errors import GeometryError
+
+        raise GeometryError(f"{kind} ({fidelity}): {exc}; parameters: {described}") from None
+    return Part(name=name or kind, mesh=mesh, regions=regions, fidelity=fidelity,
+                params={"part": kind, **params.to_dict(), "mesh": settings.to_dict()},
+                cad_mass=cad, quality=stats)

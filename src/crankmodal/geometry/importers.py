@@ -1,0 +1,212 @@
+"""Parts from files: STEP/IGES through gmsh, or any meshio-readable volume mesh.
+
+Regions of a STEP part are given geometrically (a cylinder: point, axis and radius; or a box);
+the faces of the CAD lying on them become named physical groups. A mesh file brings its own
+names: gmsh physical groups, cell sets (Abaqus ``*ELSET``, ...) and point sets (``*NSET``);
+geometric definitions may be added on top (boundary facets whose nodes all lie on the cylinder
+or in the box).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import GeometryError, InputFileError
+from ..part import Cylinder, Part, Region
+from .mesh import MeshSettings, generate, quality, set_sizes, to_meshio
+from .regions import RegionSpec, regions_from_mesh, tag_regions
+
+CAD_SUFFIXES = (".step", ".stp", ".iges", ".igs", ".brep")
+
+#: meshio volume cell types accepted.
+_VOLUME = {"tetra": 4, "tetra10": 10}
+
+
+def region_specs(defs: list) -> list:
+    """RegionSpecs from scene tables ``{name, axis = [x,y,z,dx,dy,dz], radius}`` or ``{name, box = [...]}``."""
+    specs = []
+    for i, d in enumerate(defs or []):
+        key = f"geometry.regions[{i}]"
+        name = d.get("name")
+        if not isinstance(name, str) or not name:
+            raise GeometryError(f"{key}.name: must be a non-empty string")
+        if "box" in d:
+            b = np.asarray(d["box"], float)
+            if b.shape != (6,) or np.any(b[1::2] < b[0::2]):
+                raise GeometryError(f"{key}.box: must be [xmin, xmax, ymin, ymax, zmin, zmax] (m) with min <= max")
+            specs.append(RegionSpec(name, "box", np.zeros(2), 0.0, tuple(b)))
+        elif "axis" in d and "radius" in d:
+            a = np.asarray(d["axis"], float)
+            if a.shape != (6,) or not np.linalg.norm(a[3:]) > 0:
+                raise GeometryError(f"{key}.axis: must be [x, y, z, dx, dy, dz] (m) with a non-zero direction")
+            if not float(d["radius"]) > 0:
+                raise GeometryError(f"{key}.radius: must be > 0 m, got {d['radius']!r}")
+            specs.append(RegionSpec(name, "cylinder_axis", a, float(d["radius"]), ()))
+        else:
+            raise GeometryError(f"{key}: give either box = [6 numbers] or axis = [6 numbers] and radius")
+    return specs
+
+
+def import_cad(path, specs: list, settings: MeshSettings) -> Part:
+    """Mesh a STEP/IGES/BREP file (lengths converted to metres) and name its regions."""
+    from .massprops import cad_mass_properties, compare, mesh_mass_properties
+    from .session import gmsh_session, quiet_stdout
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError(f"geometry.file: file not found: {path}")
+    with gmsh_session(f"import {path.name}", {"file": str(path)}) as gmsh:
+        gmsh.option.setString("Geometry.OCCTargetUnit", "M")
+        with quiet_stdout():
+            gmsh.model.occ.importShapes(str(path))
+        gmsh.model.occ.synchronize()
+        volumes = [t for _, t in gmsh.model.getEntities(3)]
+        if not volumes:
+            raise GeometryError(f"geometry.file: {path.name} holds no solid")
+        cad = cad_mass_properties(gmsh, volumes)
+        tagged = tag_regions(gmsh, specs)
+        gmsh.model.addPhysicalGroup(3, volumes, name="solid")
+        set_sizes(gmsh, settings, [])
+        generate(gmsh, settings)
+        mesh, index = to_meshio(gmsh)
+        regions = regions_from_mesh(gmsh, tagged, specs, index)
+        stats = quality(gmsh, mesh)
+    stats["mass_check"] = compare(cad, mesh_mass_properties(mesh.points, mesh.cells[0].data))
+    return Part(name=path.stem, mesh=mesh, regions=regions, fidelity="imported",
+                params={"file": str(path), "mesh": settings.to_dict()}, cad_mass=cad, quality=stats)
+
+
+def boundary_facets(cells: np.ndarray) -> np.ndarray:
+    """Corner triangles (n, 3) on the boundary of a tetrahedral mesh (faces used once)."""
+    c = cells[:, :4]
+    faces = np.concatenate([c[:, [0, 2, 1]], c[:, [0, 1, 3]], c[:, [0, 3, 2]], c[:, [1, 2, 3]]])
+    key = np.sort(faces, axis=1)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    return faces[first[counts == 1]]
+
+
+def _facet_nodes(cells: np.ndarray, facets: np.ndarray) -> np.ndarray:
+    """All nodes (mid-side included) on the given corner facets of a tetra/tetra10 mesh."""
+    nodes = set(np.unique(facets).tolist())
+    if cells.shape[1] == 10:
+        # meshio tetra10 edges: (0,1),(1,2),(0,2),(0,3),(1,3),(2,3)
+        edges = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
+        on = np.isin(cells[:, :4], facets)
+        for k, (i, j) in enumerate(edges):
+            both = on[:, i] & on[:, j]
+            if np.any(both):
+                ekey = np.sort(np.column_stack([cells[both, i], cells[both, j]]), axis=1)
+                fkeys = {tuple(sorted(e)) for f in facets for e in ((f[0], f[1]), (f[1], f[2]), (f[0], f[2]))}
+                mids = cells[both, 4 + k]
+                nodes.update(int(m) for (a, b), m in zip(ekey, mids) if (a, b) in fkeys)
+    return np.array(sorted(nodes), dtype=np.int64)
+
+
+def _region(name: str, cells, facets, cylinder=None) -> Region:
+    return Region(name=name, facets=facets, nodes=_facet_nodes(cells, facets), cylinder=cylinder)
+
+
+def _geometric_regions(points, cells, specs: list) -> dict:
+    facets = boundary_facets(cells)
+    scale = float(np.ptp(points, axis=0).max())
+    out = {}
+    for s in specs:
+        p = points[facets]                                   # (f, 3, 3)
+        if s.kind == "box":
+            b = np.asarray(s.z_range)
+            tol = 1e-9 * scale
+            inside = np.all((p >= b[0::2] - tol) & (p <= b[1::2] + tol), axis=(1, 2))
+            cyl = None
+        else:
+            p0, d = s.axis_xy[:3], s.axis_xy[3:] / np.linalg.norm(s.axis_xy[3:])
+            rel = p - p0
+            along = rel @ d
+            rad = np.linalg.norm(rel - along[..., None] * d, axis=-1)
+            inside = np.all(np.abs(rad - s.radius) < 1e-4 * s.radius + 1e-9 * scale, axis=1)
+            cyl = None
+            if np.any(inside):
+                t0, t1 = along[inside].min(), along[inside].max()
+                cyl = Cylinder(centre=p0 + 0.5 * (t0 + t1) * d, axis=d, radius=s.radius, length=float(t1 - t0))
+        if not np.any(inside):
+            raise GeometryError(f"region {s.name!r}: no boundary facet of the mesh lies on its definition")
+        out[s.name] = _region(s.name, cells, facets[inside], cyl)
+    return out
+
+
+def import_mesh(path, specs: list = ()) -> Part:
+    """A part from a meshio-readable volume mesh (metres assumed) with its named groups.
+
+    Names come from gmsh physical groups of triangles, cell sets of triangles, and point sets
+    (boundary facets whose corners all belong to the set). Volume cell sets are ignored.
+    """
+    import meshio
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError(f"geometry.file: file not found: {path}")
+    try:
+        m = meshio.read(path)
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - meshio raises many types, even SystemExit
+        raise InputFileError(f"geometry.file: cannot read {path.name} as a mesh ({exc})") from None
+    vol = [(i, b) for i, b in enumerate(m.cells) if b.type in _VOLUME]
+    kinds = {b.type for _, b in vol}
+    if not vol or len(kinds) != 1:
+        raise InputFileError(f"geometry.file: {path.name} must hold tetra or tetra10 cells of one kind, "
+                             f"found {sorted({b.type for b in m.cells})}")
+    kind = kinds.pop()
+    cells = np.concatenate([b.data for _, b in vol]).astype(np.int64)
+    used = np.unique(cells)
+    remap = -np.ones(len(m.points), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    points = np.asarray(m.points, float)[used]
+    if points.shape[1] != 3:
+        raise InputFileError(f"geometry.file: {path.name} is not a 3D mesh")
+    cells = remap[cells]
+
+    named = {}
+    tri = [(i, b) for i, b in enumerate(m.cells) if b.type in ("triangle", "triangle6")]
+    names_by_tag = {int(v[0]): k for k, v in (m.field_data or {}).items() if len(v) > 1 and int(v[1]) == 2}
+    phys = m.cell_data.get("gmsh:physical")
+    if phys is not None and names_by_tag:
+        for i, b in tri:
+            for tag, name in names_by_tag.items():
+                sel = np.asarray(phys[i]) == tag
+                if np.any(sel):
+                    named.setdefault(name, []).append(remap[b.data[sel, :3]])
+    for name, blocks in (m.cell_sets or {}).items():
+        if name.startswith("gmsh:") or name in named:  # meshio mirrors gmsh physical names here
+            continue
+        for i, b in tri:
+            idx = np.asarray(blocks[i]) if i < len(blocks) and blocks[i] is not None else np.zeros(0, int)
+            if len(idx):
+                named.setdefault(name, []).append(remap[b.data[idx, :3]])
+    regions = {}
+    for n, f in named.items():
+        f = np.concatenate(f)
+        if np.all(f >= 0):
+            _, first = np.unique(np.sort(f, axis=1), axis=0, return_index=True)
+            regions[n] = _region(n, cells, f[np.sort(first)])
+    if m.point_sets:
+        facets = boundary_facets(cells)
+        for name, idx in m.point_sets.items():
+            member = np.zeros(len(points), bool)
+            ids = remap[np.asarray(idx, dtype=np.int64)]
+            member[ids[ids >= 0]] = True
+            sel = np.all(member[facets], axis=1)
+            if np.any(sel) and name not in regions:
+                regions[name] = _region(name, cells, facets[sel])
+    regions.update(_geometric_regions(points, cells, list(specs)))
+    mesh = meshio.Mesh(points, [(kind, cells)])
+    from .massprops import mesh_mass_properties
+
+    try:
+        mp = mesh_mass_properties(points, cells)
+    except ValueError:
+        raise GeometryError(f"geometry.file: {path.name} has inverted elements (non-positive Jacobian); "
+                            "check its node order") from None
+    stats = {"measure": None, "n_elements": len(cells), "n_nodes": len(points),
+             "mesh_mass": mp.to_dict()}
+    return Part(name=path.stem, mesh=mesh, regions=regions, fidelity="imported",
+                params={"file": str(path)}, cad_mass=None, quality=stats)

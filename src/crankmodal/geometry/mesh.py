@@ -1,0 +1,195 @@
+"""Meshing of the current gmsh model: size fields, P1/P2 tetrahedra, optimisation, quality.
+
+Sizes: a global target ``mesh_size``; faces whose curvature radius is below ``detail_radius``
+(fillets, chamfers, holes) get ``refine * mesh_size`` on them, graded back to ``mesh_size``
+over ``2 * mesh_size`` (gmsh Distance + Threshold fields); curvature adapts the size on arcs
+(``CURVATURE_ELEMENTS`` per full circle, never below ``refine * mesh_size``). The 3D algorithm
+is gmsh's HXT on one thread (Delaunay if HXT refuses the surface mesh), so the same input gives
+the same mesh (counts and coordinates).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import GeometryError
+
+#: gmsh tetra10 -> meshio/VTK tetra10 node order (the last two edge nodes swap).
+GMSH_TO_MESHIO_TET10 = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 8])
+
+#: Elements per full circle on curved faces.
+CURVATURE_ELEMENTS = 16
+
+#: Quality measure reported (gmsh's signed inverse condition number, 1 = regular tetrahedron).
+QUALITY_MEASURE = "minSICN"
+
+
+@dataclass(frozen=True)
+class MeshSettings:
+    """Meshing settings.
+
+    Attributes
+    ----------
+    size : float
+        Global target element size, m.
+    order : int
+        1 (linear) or 2 (quadratic, curved on curved faces).
+    refine : float
+        Size on detail faces as a fraction of ``size`` (0 < refine <= 1).
+    optimize : bool
+        Run gmsh's tetrahedral optimisation after meshing (sliver removal).
+    """
+
+    size: float
+    order: int = 2
+    refine: float = 0.4
+    optimize: bool = True
+
+    def to_dict(self) -> dict:
+        return {"size": self.size, "order": self.order, "refine": self.refine, "optimize": self.optimize}
+
+
+def detail_faces(gmsh, detail_radius: float) -> list:
+    """Curved faces whose largest principal curvature exceeds ``1/detail_radius``."""
+    out = []
+    for _, s in gmsh.model.getEntities(2):
+        if gmsh.model.getType(2, s) == "Plane":
+            continue
+        lo, hi = gmsh.model.getParametrizationBounds(2, s)
+        uv = np.array([[lo[0] + f * (hi[0] - lo[0]), lo[1] + g * (hi[1] - lo[1])]
+                       for f in (0.25, 0.5, 0.75) for g in (0.25, 0.5, 0.75)]).ravel()
+        k1, k2, *_ = gmsh.model.getPrincipalCurvatures(s, uv)
+        kmax = np.max(np.abs(np.concatenate([np.asarray(k1), np.asarray(k2)])))
+        if kmax * detail_radius > 1.0 + 1e-9:
+            out.append(s)
+    return out
+
+
+def set_sizes(gmsh, settings: MeshSettings, detail: list) -> None:
+    """Configure the size fields and meshing options on the current model."""
+    opt = gmsh.option.setNumber
+    h = settings.size
+    opt("Mesh.MeshSizeMax", h)
+    opt("Mesh.MeshSizeMin", settings.refine * h)
+    opt("Mesh.MeshSizeFromCurvature", CURVATURE_ELEMENTS)
+    opt("Mesh.MeshSizeExtendFromBoundary", 1)
+    opt("Mesh.Algorithm", 6)
+    opt("Mesh.Algorithm3D", 10)
+    opt("Mesh.Optimize", 1 if settings.optimize else 0)
+    opt("Mesh.OptimizeNetgen", 0)
+    opt("Mesh.ElementOrder", 1)
+    opt("Mesh.SecondOrderLinear", 0)
+    # curved P2 elements can fold at small fillets: poor ones are untangled in generate()
+    opt("Mesh.HighOrderOptimize", 0)
+    opt("Mesh.HighOrderThresholdMin", 0.01)
+    opt("Mesh.HighOrderNumLayers", 1)  # small patches: seconds, not minutes, at 300k DOF
+    opt("Mesh.HighOrderPassMax", 10)
+    opt("Mesh.RandomSeed", 1)
+    f = gmsh.model.mesh.field
+    if detail:
+        dist = f.add("Distance")
+        f.setNumbers(dist, "SurfacesList", detail)
+        f.setNumber(dist, "Sampling", 20)
+        thr = f.add("Threshold")
+        f.setNumber(thr, "InField", dist)
+        f.setNumber(thr, "SizeMin", settings.refine * h)
+        f.setNumber(thr, "SizeMax", h)
+        f.setNumber(thr, "DistMin", 0.0)
+        f.setNumber(thr, "DistMax", 2.0 * h)
+        f.setAsBackgroundMesh(thr)
+
+
+def generate(gmsh, settings: MeshSettings) -> None:
+    """Mesh the current model in 3D at the requested order (sizes already set)."""
+    gmsh.model.mesh.generate(2)
+    try:
+        gmsh.model.mesh.generate(3)
+    except Exception:  # noqa: BLE001 - gmsh raises plain Exception; HXT refuses some surface meshes Delaunay takes
+        gmsh.option.setNumber("Mesh.Algorithm3D", 1)
+        gmsh.model.mesh.clear()
+        gmsh.model.mesh.generate(3)
+    if settings.order == 2:
+        gmsh.model.mesh.setOrder(2)
+        tags = gmsh.model.mesh.getElementsByType(11)[0]
+        if len(tags) and min(gmsh.model.mesh.getElementQualities(tags, "minSJ")) <= 0.01:
+            gmsh.model.mesh.optimize("HighOrder")
+        if len(tags) and min(gmsh.model.mesh.getElementQualities(tags, "minSJ")) <= 0:
+            raise GeometryError("mesh: curved second-order elements fold over at a small feature; "
+                                "use geometry.element_order = 1, a smaller mesh_size or refine")
+    gmsh.model.mesh.renumberNodes()
+    gmsh.model.mesh.renumberElements()
+
+
+def to_meshio(gmsh):
+    """The volume mesh of the current model as a meshio mesh, plus a gmsh-tag -> row mapper.
+
+    Returns
+    -------
+    mesh : meshio.Mesh
+        One ``tetra`` or ``tetra10`` block in meshio node order; ``cell_data["volume"]`` holds
+        the gmsh volume tag of each cell.
+    index : callable
+        Maps gmsh node tags to rows of ``mesh.points``.
+    """
+    import meshio
+
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    tags = np.asarray(tags, dtype=np.int64)
+    order = np.argsort(tags)
+    tags = tags[order]
+    points = np.asarray(coords).reshape(-1, 3)[order]
+
+    def index(t):
+        i = np.searchsorted(tags, t)
+        return i
+
+    blocks, vols = [], []
+    cell_type = None
+    for _, v in gmsh.model.getEntities(3):
+        types, _, ntags = gmsh.model.mesh.getElements(3, v)
+        for et, nt in zip(types, ntags):
+            if et == 4:
+                kind, conn = "tetra", index(np.asarray(nt, np.int64)).reshape(-1, 4)
+            elif et == 11:
+                kind, conn = "tetra10", index(np.asarray(nt, np.int64)).reshape(-1, 10)[:, GMSH_TO_MESHIO_TET10]
+            else:
+                raise GeometryError(f"mesh: unexpected volume element type {et} (only tetrahedra are made)")
+            cell_type = kind
+            blocks.append(conn)
+            vols.append(np.full(len(conn), v, dtype=np.int64))
+    if not blocks:
+        raise GeometryError("mesh: gmsh produced no volume elements; try a smaller geometry.mesh_size")
+    used = np.unique(np.concatenate(blocks))
+    if len(used) != len(points):  # drop nodes not on any tetrahedron (none expected)
+        remap = -np.ones(len(points), dtype=np.int64)
+        remap[used] = np.arange(len(used))
+        points = points[used]
+        blocks = [remap[b] for b in blocks]
+        inner = index
+
+        def index(t):
+            return remap[inner(t)]
+
+    mesh = meshio.Mesh(points, [(cell_type, np.concatenate(blocks))],
+                       cell_data={"volume": [np.concatenate(vols)]})
+    return mesh, index
+
+
+def quality(gmsh, mesh) -> dict:
+    """Element/node counts and min/mean of gmsh's minSICN over the tetrahedra."""
+    q = []
+    for _, v in gmsh.model.getEntities(3):
+        _, etags, _ = gmsh.model.mesh.getElements(3, v)
+        for et in etags:
+            if len(et):
+                q.append(np.asarray(gmsh.model.mesh.getElementQualities(et, QUALITY_MEASURE)))
+    q = np.concatenate(q)
+    return {
+        "measure": QUALITY_MEASURE,
+        "min": float(q.min()),
+        "mean": float(q.mean()),
+        "n_elements": len(mesh.cells[0].data),
+        "n_nodes": len(mesh.points),
+    }
