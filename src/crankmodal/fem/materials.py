@@ -1,0 +1,103 @@
+"""Isotropic linear-elastic materials and the TOML material library.
+
+>>> m = material("SG 700/2")
+>>> round(m.E / 1e9), m.nu, m.rho
+(176, 0.275, 7200.0)
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+from ..errors import SceneError
+
+LIBRARY = Path(__file__).with_name("materials.toml")
+
+
+@dataclass(frozen=True)
+class Material:
+    """An isotropic linear-elastic material.
+
+    Attributes
+    ----------
+    name : str
+    E : float
+        Young's modulus, Pa.
+    nu : float
+        Poisson's ratio, in (-1, 0.5).
+    rho : float
+        Density, kg/m³.
+    yield_strength, ultimate_strength : float or None
+        Pa; safety factors need them.
+    description : str
+    """
+
+    name: str
+    E: float
+    nu: float
+    rho: float
+    yield_strength: float | None = None
+    ultimate_strength: float | None = None
+    description: str = ""
+
+    def __post_init__(self):
+        for key, value, ok, text in (
+            ("E", self.E, self.E > 0, "> 0 Pa"),
+            ("nu", self.nu, -1.0 < self.nu < 0.5, "in (-1, 0.5)"),
+            ("rho", self.rho, self.rho > 0, "> 0 kg/m^3"),
+        ):
+            if not ok:
+                raise SceneError(f"material.{key}: must be {text}, got {value!r} ({self.name})")
+        for key in ("yield_strength", "ultimate_strength"):
+            v = getattr(self, key)
+            if v is not None and not v > 0:
+                raise SceneError(f"material.{key}: must be > 0 Pa, got {v!r} ({self.name})")
+
+    @property
+    def lame(self) -> tuple[float, float]:
+        """Lamé parameters (λ, μ), Pa."""
+        return lame_parameters(self.E, self.nu)
+
+    @property
+    def shear_modulus(self) -> float:
+        """G = E / (2 (1 + ν)), Pa."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name, "E_pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
+            "yield_strength_pa": self.yield_strength,
+            "ultimate_strength_pa": self.ultimate_strength,
+            "description": self.description,
+        }
+
+
+def lame_parameters(E: float, nu: float) -> tuple[float, float]:
+    """Lamé parameters (λ, μ) in Pa from Young's modulus (Pa) and Poisson's ratio."""
+    return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+
+
+@lru_cache(maxsize=1)
+def library() -> dict[str, dict]:
+    """The material library as raw tables, keyed by name."""
+    with open(LIBRARY, "rb") as fh:
+        return tomllib.load(fh)
+
+
+def material(name: str) -> Material:
+    """A material of the library by name (case-insensitive).
+
+    Raises
+    ------
+    SceneError
+        If the name is not in the library; the message lists the known names.
+    """
+    lib = library()
+    by_lower = {k.lower(): k for k in lib}
+    key = by_lower.get(str(name).strip().lower())
+    if key is None:
+        raise SceneError(f"material.name: unknown material {name!r}; known: {', '.join(lib)}")
+    return Material(name=key, **lib[key])

@@ -1,0 +1,90 @@
+"""The ``[modal]`` scene section: free-free or supported natural frequencies and mode shapes.
+
+Fixed keys (../shared/SCENES.md): ``n_modes``, ``supports``. Own keys: ``band``, ``backend``,
+``tol``, ``axis``, ``vtu``. Results: ``frequencies_hz`` (elastic, ascending, ``n_modes``),
+``rigid_body_modes``, ``n_dofs``, ``n_elements``, mode ``classes``, effective masses, residual
+and orthogonality checks, timings per phase, peak memory; mode shapes to ``modes.vtu``.
+"""
+
+from __future__ import annotations
+
+import time
+
+from ..schema import Field
+from ..schema import validate as validate_table
+from .stage_common import BACKEND_FIELD, fe_model, part_and_material
+
+SECTION = "modal"
+REQUIRES = ("geometry", "material")
+
+
+def _band_check(v):
+    return None if 0 <= v[0] < v[1] else f"must be [f_min, f_max] Hz with 0 <= f_min < f_max, got {v}"
+
+
+SCHEMA: dict[str, Field] = {
+    "n_modes": Field("int", 12, "number of elastic (non-rigid) modes wanted", ge=1, le=500),
+    "supports": Field("tables", [], "supports {box = [xmin, xmax, ymin, ymax, zmin, zmax], fix = 'xyz'} "
+                      "or {region = name, fix = 'x'|'xy'|...|'radial'}; empty: free-free"),
+    "band": Field("floats", None, "analysis band [f_min, f_max], Hz (flags the modes inside)",
+                  length=2, check=_band_check),
+    "backend": BACKEND_FIELD,
+    "tol": Field("float", 1e-6, "largest admissible eigen-residual and M-orthogonality defect",
+                 gt=0.0, lt=1.0),
+    "axis": Field("floats", None, "long axis for naming modes (default: principal axis)", length=3),
+    "vtu": Field("bool", True, "write the mode shapes to modes.vtu"),
+}
+
+
+def validate(raw: dict, scene) -> dict:
+    from .supports import validate_specs
+
+    p = validate_table(SECTION, raw, SCHEMA)
+    p["supports"] = validate_specs(p["supports"], SECTION)
+    return p
+
+
+def run(p: dict, ctx) -> dict:
+    from .assembly import mass_properties
+    from .classify import classify
+    from .memory import PeakMemory
+    from .modal import solve_modes
+    from .supports import select
+    from .vtu import write_modes
+
+    part, mat = part_and_material(ctx, SECTION)
+    with PeakMemory() as mem:
+        t0 = time.perf_counter()
+        model = fe_model(ctx, part, mat)
+        t_asm = time.perf_counter() - t0
+        sup = select(part, p["supports"], SECTION)
+        modes = solve_modes(model, p["n_modes"], sup, backend=p["backend"],
+                            band=p["band"], tol=p["tol"])
+        classes = classify(model.points[model.used], modes.shapes.reshape(-1, 3, modes.shapes.shape[1])
+                           [model.used].reshape(-1, modes.shapes.shape[1]), axis=p["axis"])
+    ctx.products[SECTION] = modes
+    mp = mass_properties(model)
+    res = modes.to_dict()
+    res.update({
+        "n_elements": model.n_elements,
+        "element_order": model.order,
+        "classes": [c["label"] for c in classes],
+        "class_fractions": [{k: float(v) for k, v in c.items() if k != "label"} for c in classes],
+        "supports": [{"label": s.label, "fix": s.fix, "n_nodes": len(s.nodes)} for s in sup],
+        "mass_kg": mp["mass"],
+        "timings_s": {**model.timings, "assembly_total_s": t_asm, **modes.timings},
+        "peak_memory_bytes": mem.peak,
+        "warnings": list(model.warnings),
+    })
+    if part.cad_mass is not None:
+        cad = part.cad_mass.mass(mat.rho)
+        res["mass_vs_cad"] = mp["mass"] / cad - 1.0
+    if p["vtu"]:
+        res["vtu"] = str(write_modes(ctx.out_dir / "modes.vtu", part.mesh,
+                                     modes.frequencies_hz, modes.shapes))
+    f = modes.frequencies_hz
+    kind = "free-free" if not sup else f"{len(sup)} supports"
+    res["summary"] = (f"{len(f)} elastic modes ({kind}, {modes.rigid_body_modes} rigid), "
+                      f"{f[0]:.1f}-{f[-1]:.1f} Hz; {modes.n_dofs} DOF, "
+                      f"{sum(res['timings_s'][k] for k in ('assembly_total_s', 'reduce_s', 'factorize_s', 'eigsh_s')):.1f} s")
+    return res

@@ -1,0 +1,177 @@
+"""Sparse symmetric factorisations behind one interface.
+
+``factorize(A, backend)`` returns an object with ``solve(b)`` that reuses one factorisation for
+every right-hand side (the shift-invert Lanczos loop calls it a few dozen times).
+
+Backends
+--------
+``pardiso``
+    Intel MKL PARDISO through the ``pypardiso`` wheel (pip-only: it brings MKL). Real symmetric
+    positive-definite or indefinite LDLᵀ on the upper triangle; iterative refinement is off
+    (with it on, residuals degraded to ~1e-6 and the time doubled on this machine).
+``superlu``
+    scipy's SuperLU, always available; a general LU, several times slower and hungrier.
+``auto``
+    ``pardiso`` when importable, else ``superlu``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import SceneError
+
+BACKENDS = ("auto", "pardiso", "superlu")
+
+
+def available_backends() -> list[str]:
+    """Backends that can run here, the default first."""
+    out = []
+    try:
+        import pypardiso  # noqa: F401
+
+        out.append("pardiso")
+    except ImportError:
+        pass
+    return out + ["superlu"]
+
+
+def resolve_backend(backend: str) -> str:
+    """The concrete backend ``auto`` stands for; checks an explicit one is installed."""
+    if backend not in BACKENDS:
+        raise SceneError(f"backend: must be one of {', '.join(BACKENDS)}; got {backend!r}")
+    have = available_backends()
+    if backend == "auto":
+        return have[0]
+    if backend not in have:
+        raise SceneError(f"backend: {backend!r} is not installed (pip install pypardiso); "
+                         f"available: {', '.join(have)}")
+    return backend
+
+
+class SuperLUFactor:
+    """scipy SuperLU (COLAMD ordering) of a square sparse matrix."""
+
+    name = "superlu"
+
+    def __init__(self, A):
+        from scipy.sparse.linalg import splu
+
+        self._lu = splu(sp.csc_matrix(A), permc_spec="COLAMD")
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        return self._lu.solve(np.asarray(b, float))
+
+
+class PardisoFactor:
+    """MKL PARDISO of a real symmetric matrix (phases 11+22 once, phase 33 per solve).
+
+    Parameters
+    ----------
+    A : sparse matrix
+        Symmetric; only its upper triangle is used.
+    upper : bool
+        ``A`` already is that upper triangle (saves a copy).
+    positive_definite : bool
+        ``True``: Cholesky (mtype 2); ``False``: Bunch-Kaufman LDLᵀ (mtype -2).
+    """
+
+    name = "pardiso"
+
+    def __init__(self, A, positive_definite: bool = True, ordering: int = 2,
+                 upper: bool = False):
+        import pypardiso
+
+        self._lib = pypardiso.PyPardisoSolver()._mkl_pardiso  # finds and binds mkl_rt
+        U = sp.csr_matrix(A) if upper else sp.triu(sp.csr_matrix(A), format="csr")
+        U.sort_indices()
+        if np.any(np.diff(U.indptr) == 0):
+            raise ValueError("matrix has an empty row")
+        self.n = U.shape[0]
+        self._data = np.ascontiguousarray(U.data, dtype=np.float64)
+        self._ia = (U.indptr + 1).astype(np.int32)
+        self._ja = (U.indices + 1).astype(np.int32)
+        self.mtype = 2 if positive_definite else -2
+        self.pt = np.zeros(64, np.int64)
+        self.iparm = np.zeros(64, np.int32)
+        ip = self.iparm
+        ip[0] = 1    # explicit parameters
+        ip[1] = ordering  # 2: METIS nested dissection, 3: its parallel version, 0: AMD
+        ip[7] = 0    # no iterative refinement unless pivots were perturbed (none for mtype 2)
+        ip[9] = 8    # pivot perturbation 1e-8 (mtype -2)
+        ip[10] = 0   # no scaling (symmetric)
+        ip[12] = 0   # no weighted matching (symmetric)
+        ip[17] = -1  # report nnz of the factor
+        ip[20] = 1   # Bunch-Kaufman pivoting (mtype -2)
+        ip[34] = 0   # one-based ia/ja
+        self._call(12, np.zeros((self.n, 1)))
+        self.factor_nnz = int(self.iparm[17])
+        self.n_negative = int(self.iparm[22])
+
+    def _call(self, phase: int, b: np.ndarray) -> np.ndarray:
+        b = np.asfortranarray(b, dtype=np.float64)
+        x = np.zeros_like(b)
+        err = ctypes.c_int32(0)
+        i32 = ctypes.POINTER(ctypes.c_int32)
+        f64 = ctypes.POINTER(ctypes.c_double)
+        nrhs = 1 if b.ndim == 1 else b.shape[1]
+        self._lib(self.pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)),
+                  ctypes.byref(ctypes.c_int32(1)), ctypes.byref(ctypes.c_int32(1)),
+                  ctypes.byref(ctypes.c_int32(self.mtype)), ctypes.byref(ctypes.c_int32(phase)),
+                  ctypes.byref(ctypes.c_int32(self.n)), self._data.ctypes.data_as(f64),
+                  self._ia.ctypes.data_as(i32), self._ja.ctypes.data_as(i32),
+                  np.zeros(0, np.int32).ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(nrhs)),
+                  self.iparm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(0)),
+                  b.ctypes.data_as(f64), x.ctypes.data_as(f64), ctypes.byref(err))
+        if err.value != 0:
+            raise np.linalg.LinAlgError(f"PARDISO phase {phase} failed with error {err.value}"
+                                        + (" (matrix not positive definite)"
+                                           if err.value == -4 else ""))
+        return x
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        b = np.asarray(b, float)
+        return self._call(33, b).reshape(b.shape)
+
+    def __del__(self):
+        try:
+            if self.pt.any():
+                self._call(-1, np.zeros((self.n, 1)))
+        except Exception:  # noqa: BLE001, S110 - interpreter shutdown: nothing left to free
+            pass
+
+
+def factorize(A, backend: str = "auto", positive_definite: bool = True):
+    """Factorise a symmetric sparse matrix once.
+
+    Parameters
+    ----------
+    A : scipy sparse matrix, shape (n, n)
+    backend : {"auto", "pardiso", "superlu"}
+    positive_definite : bool
+        Whether ``A`` is known to be positive definite (Cholesky is used where possible).
+
+    Returns
+    -------
+    object with ``solve(b)`` and ``name``.
+    """
+    name = resolve_backend(backend)
+    if name == "pardiso":
+        return PardisoFactor(A, positive_definite=positive_definite)
+    return SuperLUFactor(A)
+
+
+def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_definite: bool = True):
+    """Factorise ``K - σM`` without keeping the full shifted matrix (PARDISO: upper triangle only).
+
+    Saves one matrix of the size of K at the memory peak of a large modal solve.
+    """
+    name = resolve_backend(backend)
+    if name == "pardiso":
+        U = sp.triu(K, format="csr")
+        U -= sigma * sp.triu(M, format="csr")
+        return PardisoFactor(U.tocsr(), positive_definite=positive_definite, upper=True)
+    return SuperLUFactor(K - sigma * M)

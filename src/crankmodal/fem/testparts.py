@@ -1,0 +1,155 @@
+"""Simple structured parts for verification and benchmarks: prismatic bars and thick tubes.
+
+They are built without gmsh (a structured tetrahedral grid from scikit-fem, mapped), so tests can
+make them in milliseconds. P2 mid-side nodes are placed in the parameter space before mapping, so
+a tube's P2 elements follow its circles (curved, isoparametric).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..part import Cylinder, MassProperties, Part, Region
+
+#: tetra10 edges in meshio's (VTK) node order, nodes 4..9.
+TET10_EDGES = np.array([[0, 1], [1, 2], [0, 2], [0, 3], [1, 3], [2, 3]])
+_TET_FACES = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
+
+
+def elevate_to_p2(points: np.ndarray, tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Add straight mid-edge nodes: (points, tetra) → (points, tetra10 in meshio order)."""
+    e = np.sort(tets[:, TET10_EDGES], axis=2).reshape(-1, 2)
+    uniq, inv = np.unique(e, axis=0, return_inverse=True)
+    mids = 0.5 * (points[uniq[:, 0]] + points[uniq[:, 1]])
+    t10 = np.hstack([tets, len(points) + inv.reshape(len(tets), 6)])
+    return np.vstack([points, mids]), t10
+
+
+def boundary_facets(cells: np.ndarray) -> np.ndarray:
+    """Corner triangles (n, 3) that belong to exactly one tetrahedron."""
+    f = np.sort(cells[:, :4][:, _TET_FACES], axis=2).reshape(-1, 3)
+    uniq, counts = np.unique(f, axis=0, return_counts=True)
+    return uniq[counts == 1]
+
+
+def facet_nodes(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """All nodes (corners and, for tetra10, mid-edge nodes) of corner triangles."""
+    nodes = [facets.ravel()]
+    if cells.shape[1] == 10:
+        n = cells.max() + 1
+        e = np.sort(cells[:, TET10_EDGES], axis=2).reshape(-1, 2)
+        keys = e[:, 0].astype(np.int64) * n + e[:, 1]
+        mids = cells[:, 4:].ravel()
+        order = np.argsort(keys)
+        keys, mids = keys[order], mids[order]
+        fe = np.sort(facets[:, [[0, 1], [1, 2], [0, 2]]], axis=2).reshape(-1, 2)
+        fk = fe[:, 0].astype(np.int64) * n + fe[:, 1]
+        nodes.append(mids[np.searchsorted(keys, fk)])
+    return np.unique(np.concatenate(nodes))
+
+
+def region(name: str, points, cells, facets, select, cylinder=None) -> Region:
+    """Region of the boundary facets whose centroid satisfies ``select(xyz) -> bool array``."""
+    c = points[facets].mean(axis=1)
+    f = facets[np.asarray(select(c), bool)]
+    return Region(name=name, facets=f, nodes=facet_nodes(f, cells), cylinder=cylinder)
+
+
+def _mesh(points, tets, order):
+    import meshio
+
+    if order == 2:
+        points, tets = elevate_to_p2(points, tets)
+        return meshio.Mesh(points, [("tetra10", tets)])
+    return meshio.Mesh(points, [("tetra", tets)])
+
+
+def _grid(n):
+    from skfem import MeshTet
+
+    m = MeshTet.init_tensor(*(np.linspace(0.0, 1.0, k + 1) for k in n))
+    return m.p.T.copy(), m.t.T.copy()
+
+
+def bar(length=1.0, width=0.05, height=0.05, divisions=(20, 2, 2), order=2) -> Part:
+    """A prismatic bar along x, cross-section width (y) × height (z), m, centred on the x axis.
+
+    Regions: ``end_x0`` (x = 0), ``end_x1`` (x = length), ``top`` (z = +h/2), ``bottom``.
+    """
+    p, t = _grid(divisions)
+    scale = np.array([length, width, height])
+    p = p * scale - np.array([0.0, width / 2, height / 2])
+    mesh = _mesh(p, t, order)
+    pts, cells = mesh.points, mesh.cells[0].data
+    fac = boundary_facets(cells)
+    tol = 1e-9 * length
+    regions = {
+        "end_x0": region("end_x0", pts, cells, fac, lambda c: c[:, 0] < tol),
+        "end_x1": region("end_x1", pts, cells, fac, lambda c: c[:, 0] > length - tol),
+        "top": region("top", pts, cells, fac, lambda c: c[:, 2] > height / 2 - tol),
+        "bottom": region("bottom", pts, cells, fac, lambda c: c[:, 2] < -height / 2 + tol),
+    }
+    b, h, L = width, height, length
+    inertia = np.diag([b * h * L * (b * b + h * h) / 12, b * h * L * (L * L + h * h) / 12,
+                       b * h * L * (L * L + b * b) / 12])
+    cad = MassProperties(volume=b * h * L, centroid=np.array([L / 2, 0, 0]),
+                         inertia_per_density=inertia)
+    return Part(name="bar", mesh=mesh, regions=regions, fidelity="full",
+                params={"length": length, "width": width, "height": height}, cad_mass=cad)
+
+
+def tube(inner_radius=0.05, outer_radius=0.1, length=0.1, divisions=(4, 16, 2),
+         angle=2 * np.pi, order=2) -> Part:
+    """A thick tube along z (a full ring, or a sector of ``angle`` rad starting at +x).
+
+    Regions: ``bore`` (r = inner, with its Cylinder), ``outer`` (with its Cylinder), ``end_z0``,
+    ``end_z1``, and for a sector ``cut_0`` (y = 0) and ``cut_1`` (the other cut).
+    """
+    full = np.isclose(angle, 2 * np.pi)
+    p, t = _grid(divisions)
+    if order == 2:
+        p, t = elevate_to_p2(p, t)
+    a, b = inner_radius, outer_radius
+    r = a + (b - a) * p[:, 0]
+    th = angle * p[:, 1]
+    z = length * p[:, 2]
+    x = np.column_stack([r * np.cos(th), r * np.sin(th), z])
+    if full:  # merge the seam θ = 0 ≡ 2π
+        key = np.round(p * 2 * np.array(divisions)).astype(np.int64)  # half-steps: P2 too
+        key[:, 1] %= 2 * divisions[1]
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        x, t = x[first], inv.ravel()[t]
+    import meshio
+
+    mesh = meshio.Mesh(x, [("tetra10" if order == 2 else "tetra", t)])
+    pts, cells = mesh.points, t
+    fac = boundary_facets(cells)
+    tol = 1e-6 * b
+    rad = lambda c: np.hypot(c[:, 0], c[:, 1])
+    cyl = lambda R: Cylinder(np.array([0, 0, length / 2]), np.array([0.0, 0, 1]), R, length)
+    # facet centroids of a curved surface lie slightly inside it: select by node radii instead
+    rmin = np.hypot(*pts[fac][:, :, :2].transpose(2, 0, 1)).min(axis=1)
+    rmax = np.hypot(*pts[fac][:, :, :2].transpose(2, 0, 1)).max(axis=1)
+    sel_bore = np.abs(rmax - a) < tol
+    sel_outer = np.abs(rmin - b) < tol
+    regions = {
+        "bore": Region("bore", fac[sel_bore], facet_nodes(fac[sel_bore], cells), cyl(a)),
+        "outer": Region("outer", fac[sel_outer], facet_nodes(fac[sel_outer], cells), cyl(b)),
+        "end_z0": region("end_z0", pts, cells, fac, lambda c: c[:, 2] < tol),
+        "end_z1": region("end_z1", pts, cells, fac, lambda c: c[:, 2] > length - tol),
+    }
+    if not full:
+        n1 = np.array([-np.sin(angle), np.cos(angle), 0.0])
+        regions["cut_0"] = region("cut_0", pts, cells, fac, lambda c: np.abs(c[:, 1]) < tol)
+        regions["cut_1"] = region("cut_1", pts, cells, fac,
+                                  lambda c: (np.abs(c @ n1) < tol) & (rad(c) > 0.5 * a))
+    vol = 0.5 * angle * (b * b - a * a) * length
+    cad = None
+    if full:
+        izz = 0.5 * vol * (a * a + b * b)
+        ixx = vol * (3 * (a * a + b * b) + length ** 2) / 12
+        cad = MassProperties(volume=vol, centroid=np.array([0, 0, length / 2]),
+                             inertia_per_density=np.diag([ixx, ixx, izz]))
+    return Part(name="tube", mesh=mesh, regions=regions, fidelity="full",
+                params={"inner_radius": a, "outer_radius": b, "length": length,
+                        "angle": angle}, cad_mass=cad)

@@ -1,0 +1,149 @@
+"""Modal analysis against beam theory, rigid-body physics and its own numerical checks."""
+
+import numpy as np
+import pytest
+from fem_beam_theory import rectangle_shear_coefficient, timoshenko_frequencies
+from fem_parts import bar, tube
+
+from crankmodal.errors import NumericalError
+from crankmodal.fem import assembly, modal, supports
+from crankmodal.fem.materials import material
+
+STEEL = material("steel")
+L, B, H = 1.0, 0.05, 0.04  # bending about y (z-motion, I = B H^3/12) is the lowest
+
+
+@pytest.fixture(scope="module")
+def bar_model():
+    part = bar(L, B, H, (40, 3, 3), order=2)  # moderate mesh: 12 k DOF
+    return part, assembly.assemble(part, STEEL)
+
+
+@pytest.fixture(scope="module")
+def free_modes(bar_model):
+    return modal.solve_modes(bar_model[1], 8)
+
+
+def _theory(ends, n, inertia):
+    return timoshenko_frequencies(n, L, STEEL.E, STEEL.nu, STEEL.rho, B * H, inertia,
+                                  rectangle_shear_coefficient(STEEL.nu), ends=ends)
+
+
+def test_free_free_bar_first_bending_modes_within_0p5_percent_of_timoshenko(free_modes):
+    f = free_modes.frequencies_hz
+    # the eight lowest: bending about y (3), about z (3), interleaved; pick by theory
+    fy = _theory("free-free", 3, B * H**3 / 12)
+    fz = _theory("free-free", 2, H * B**3 / 12)
+    for ft in np.concatenate([fy, fz]):
+        err = np.min(np.abs(f / ft - 1))
+        assert err < 0.005, (ft, f)
+
+
+def test_free_part_has_six_rigid_body_modes(free_modes):
+    assert free_modes.rigid_body_modes == 6
+    assert np.all(free_modes.rigid_frequencies_hz < 1e-3 * free_modes.frequencies_hz[0])
+
+
+def test_clamped_cantilever_first_bending_within_0p5_percent_of_timoshenko(bar_model):
+    part, model = bar_model
+    sup = supports.select(part, [{"region": "end_x0", "fix": "xyz"}])
+    m = modal.solve_modes(model, 4, sup)
+    assert m.rigid_body_modes == 0
+    fy = _theory("clamped-free", 2, B * H**3 / 12)
+    fz = _theory("clamped-free", 1, H * B**3 / 12)
+    for ft in np.concatenate([fy, fz]):
+        # the fully clamped 3-D root is slightly stiffer than a Timoshenko clamp
+        assert np.min(np.abs(m.frequencies_hz / ft - 1)) < 0.005, (ft, m.frequencies_hz)
+    # first cantilever mode carries 61.3 % of the mass in its direction (Euler-Bernoulli
+    # 0.6131; shear and 3-D effects are < 1 % at L/h = 25)
+    assert m.effective_mass[0, 2] / m.total_mass == pytest.approx(0.6131, rel=0.01)
+
+
+def test_mass_matrix_integrates_to_exact_mass_and_inertia_of_a_bar(bar_model):
+    part, model = bar_model
+    mp = assembly.mass_properties(model)
+    assert mp["mass"] == pytest.approx(part.cad_mass.mass(STEEL.rho), rel=1e-12)
+    np.testing.assert_allclose(mp["centre"], part.cad_mass.centroid, atol=1e-12)
+    np.testing.assert_allclose(mp["inertia"], part.cad_mass.inertia(STEEL.rho),
+                               rtol=1e-10, atol=1e-12)
+
+
+def test_curved_p2_tube_mass_and_inertia_match_the_exact_annulus_to_1e_4():
+    part = tube(0.05, 0.1, 0.1, (3, 16, 2), order=2)
+    mp = assembly.mass_properties(assembly.assemble(part, STEEL))
+    assert mp["mass"] == pytest.approx(part.cad_mass.mass(STEEL.rho), rel=1e-4)
+    np.testing.assert_allclose(np.diag(mp["inertia"]), np.diag(part.cad_mass.inertia(STEEL.rho)),
+                               rtol=2e-4)
+
+
+def test_elastic_modes_are_mass_normalised_and_orthogonal_to_rigid_motion(bar_model, free_modes):
+    model = bar_model[1]
+    X = free_modes.shapes
+    np.testing.assert_allclose(X.T @ (model.M @ X), np.eye(X.shape[1]), atol=1e-8)
+    assert free_modes.residuals.max() < 1e-6
+    # free-free elastic modes have no effective mass (momentum is conserved)
+    assert free_modes.effective_mass.max() < 1e-8 * free_modes.total_mass
+
+
+def test_same_input_gives_identical_modes(bar_model, free_modes):
+    again = modal.solve_modes(bar_model[1], 8)
+    np.testing.assert_array_equal(again.frequencies_hz, free_modes.frequencies_hz)
+    np.testing.assert_array_equal(again.shapes, free_modes.shapes)
+
+
+def test_sub_millimetre_part_scales_frequencies_inversely_with_size():
+    """A 0.5 mm bar has exactly 2000× the frequencies of a 1 m bar: the solver is scale-free."""
+    big = modal.solve_modes(assembly.assemble(bar(1.0, 0.05, 0.04, (16, 2, 2)), STEEL), 4)
+    with pytest.warns(assembly.ModelWarning, match="metres"):
+        small_model = assembly.assemble(bar(5e-4, 2.5e-5, 2e-5, (16, 2, 2)), STEEL)
+    small = modal.solve_modes(small_model, 4)
+    np.testing.assert_allclose(small.frequencies_hz, 2e3 * big.frequencies_hz, rtol=1e-7)
+    assert small.rigid_body_modes == 6
+
+
+def test_part_given_in_millimetres_warns_about_units():
+    with pytest.warns(assembly.ModelWarning, match="mm input"):
+        assembly.assemble(bar(1000.0, 50.0, 40.0, (8, 1, 1), order=1), STEEL)
+
+
+def test_p1_with_nearly_incompressible_material_warns_about_locking():
+    rubberish = material("steel").__class__(name="x", E=1e7, nu=0.49, rho=1000.0)
+    with pytest.warns(assembly.ModelWarning, match="locking"):
+        assembly.assemble(bar(1.0, 0.1, 0.1, (4, 1, 1), order=1), rubberish)
+
+
+def test_residual_check_fires_on_a_wrong_eigenvalue(bar_model, free_modes):
+    model = bar_model[1]
+    lam = (2 * np.pi * free_modes.frequencies_hz) ** 2
+    with pytest.raises(NumericalError, match="residual"):
+        modal.check_pairs(model.K, model.M, lam * 1.001, free_modes.shapes)
+
+
+def test_orthogonality_check_fires_on_nearly_parallel_modes(bar_model, free_modes):
+    model = bar_model[1]
+    X = free_modes.shapes[:, :2].copy()
+    X[:, 1] = X[:, 0] + 1e-3 * X[:, 1]
+    X /= np.sqrt(np.einsum("ij,ij->j", X, model.M @ X))
+    lam = np.full(2, (2 * np.pi * free_modes.frequencies_hz[0]) ** 2)
+    with pytest.raises(NumericalError, match="M-orthogonal"):
+        modal.check_pairs(model.K, model.M, lam, X, tol=1e-2)
+
+
+def test_radial_bearing_leaves_axial_sliding_and_spin_then_an_axial_stop_leaves_spin():
+    part = tube(0.02, 0.05, 0.2, (2, 12, 6), order=2)
+    model = assembly.assemble(part, STEEL)
+    radial = supports.select(part, [{"region": "bore", "fix": "radial"}])
+    assert modal.solve_modes(model, 3, radial).rigid_body_modes == 2
+    stop = supports.select(part, [{"region": "bore", "fix": "radial"},
+                                  {"region": "end_z0", "fix": "z"}])
+    m = modal.solve_modes(model, 3, stop)
+    assert m.rigid_body_modes == 1  # seed 004's "rotation about the crankshaft axis kept free"
+
+
+def test_radial_support_fits_the_cylinder_when_the_region_has_none():
+    part = tube(0.02, 0.05, 0.2, (2, 12, 6), order=2)
+    bore = part.regions["bore"]
+    part.regions["bore"] = type(bore)(bore.name, bore.facets, bore.nodes, None)
+    sup = supports.select(part, [{"region": "bore", "fix": "radial"}])
+    np.testing.assert_allclose(abs(sup[0].cylinder.axis[2]), 1.0, atol=1e-9)
+    assert sup[0].cylinder.radius == pytest.approx(0.02, rel=1e-3)
