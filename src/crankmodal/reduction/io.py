@@ -1,0 +1,108 @@
+"""The ``.npz`` file of a reduced flexible body — readable with plain numpy.
+
+Format ``crankmodal-flexbody``, version 1. Open with ``np.load(path)`` (no pickle needed). SI
+units; ``n`` orthonormal modes (the six rigid ones first), ``m`` interface nodes, ``p`` mesh
+points (only when stress modes were stored).
+
+=========================  ==================  ===============================================
+key                        shape / dtype       meaning
+=========================  ==================  ===============================================
+format                     str                 ``"crankmodal-flexbody"``
+version                    int                 1
+name                       str                 body name
+frequencies_hz             (n,)                0 for rigid modes, ascending
+stiffness                  (n, n)              modal stiffness ``diag(ω²)``, 1/s²
+mass                       (n, n)              modal mass (identity)
+rigid                      (n,) bool           rigid-body modes
+interface_names            (m,) str
+interface_kinds            (m,) str            ``rigid`` or ``distributing``
+interface_centres          (m, 3)              interface node positions, m
+interface_axes             (m, 3)              bore axes (NaN: none)
+interface_map              (m, 6, n)           ``q_r = interface_map[r] @ ξ`` (m, rad)
+cb_stiffness, cb_mass      (n, n)              Craig–Bampton matrices
+cb_to_modal                (n, n)              CB coordinates = ``cb_to_modal @ ξ``
+n_fixed_interface_modes    int
+fixed_interface_hz         (k,)
+mass_kg                    float
+centre_of_mass             (3,)                m
+inertia                    (3, 3)              about the centre of mass, kg m²
+I1 … I9                    see flexbody.py     Shabana inertia invariants of the elastic modes
+n_full_dofs                int
+stress_modes               (p, 6, n) optional  Pa per unit ξ, Voigt xx yy zz yz xz xy
+stress_points              (p, 3) optional     m
+info_json                  str                 provenance as JSON
+=========================  ==================  ===============================================
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputFileError
+from .flexbody import FlexibleBody
+
+FORMAT = "crankmodal-flexbody"
+VERSION = 1
+_ARRAYS = ("frequencies_hz", "stiffness", "mass", "rigid", "interface_centres", "interface_axes",
+           "interface_map", "cb_stiffness", "cb_mass", "cb_to_modal", "fixed_interface_hz",
+           "centre_of_mass", "inertia")
+
+
+def save_flexbody(path, body: FlexibleBody) -> Path:
+    """Write ``body`` to ``path`` (``.npz``, uncompressed); returns the path."""
+    path = Path(path)
+    data = {k: np.asarray(getattr(body, k)) for k in _ARRAYS}
+    data.update({
+        "format": np.array(FORMAT), "version": np.array(VERSION), "name": np.array(body.name),
+        "interface_names": np.array(body.interface_names, dtype=str),
+        "interface_kinds": np.array(body.interface_kinds, dtype=str),
+        "n_fixed_interface_modes": np.array(body.n_fixed_interface_modes),
+        "mass_kg": np.array(body.mass_kg), "n_full_dofs": np.array(body.n_full_dofs),
+        "info_json": np.array(json.dumps(body.info, default=float)),
+    })
+    data.update({k: np.asarray(v) for k, v in body.invariants.items()})
+    if body.stress_modes is not None:
+        data["stress_modes"] = body.stress_modes
+        data["stress_points"] = body.stress_points
+    tmp = path.with_name(path.name + ".tmp.npz")
+    np.savez(tmp, **data)
+    tmp.replace(path)
+    return path
+
+
+def load_flexbody(path) -> FlexibleBody:
+    """Read a body written by :func:`save_flexbody`.
+
+    Raises
+    ------
+    InputFileError
+        Missing file, or not a ``crankmodal-flexbody`` file of a known version.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError(f"flexible body file not found: {path}")
+    try:
+        z = np.load(path, allow_pickle=False)
+    except (OSError, ValueError, zipfile.BadZipFile) as exc:
+        raise InputFileError(f"{path}: not a readable .npz file ({exc})") from None
+    with z:
+        if "format" not in z.files or str(z["format"]) != FORMAT:
+            raise InputFileError(f"{path}: not a {FORMAT} file")
+        if int(z["version"]) != VERSION:
+            raise InputFileError(f"{path}: {FORMAT} version {int(z['version'])}; "
+                                 f"this crankmodal reads version {VERSION}")
+        kw = {k: z[k] for k in _ARRAYS}
+        return FlexibleBody(
+            name=str(z["name"]), interface_names=[str(s) for s in z["interface_names"]],
+            interface_kinds=[str(s) for s in z["interface_kinds"]],
+            n_fixed_interface_modes=int(z["n_fixed_interface_modes"]),
+            mass_kg=float(z["mass_kg"]), n_full_dofs=int(z["n_full_dofs"]),
+            invariants={f"I{i}": (float(z[f"I{i}"]) if i == 1 else z[f"I{i}"])
+                        for i in range(1, 10)},
+            stress_modes=z["stress_modes"] if "stress_modes" in z.files else None,
+            stress_points=z["stress_points"] if "stress_points" in z.files else None,
+            info=json.loads(str(z["info_json"])), **kw)
