@@ -41,3 +41,13 @@ def test_to_jsonable_uses_to_dict():
             return {"x": np.float32(1.5)}
 
     assert to_jsonable({"r": R()}) == {"r": {"x": 1.5}}
+
+
+def test_atomic_write_gives_an_ordinary_readable_file(tmp_path):
+    import os
+    import stat
+
+    p = write_atomic(tmp_path / "r.txt", "x")
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE(p.stat().st_mode) == 0o666 & ~mask

@@ -1,4 +1,4 @@
-"""Command line: ``crankmodal run | check | demo | machines``.
+"""Command line: ``crankmodal run | check | demo | study | machines``.
 
 User errors (:class:`~crankmodal.errors.CrankmodalError`) print one line on stderr and exit with
 status 2 (3 for a failed numerical check), without a traceback unless ``--debug`` is given.
@@ -48,6 +48,13 @@ def _parser() -> argparse.ArgumentParser:
     d.add_argument("--out", type=Path, help="output folder (default out/four_star_compressor)")
     d.add_argument("--no-figures", action="store_true", help="skip PNG plots")
 
+    st = sub.add_parser("study", help="run a study of a scene's part (see README)")
+    st.add_argument("kind", choices=("simplification",),
+                    help="simplification: fidelities x mesh sizes x element orders")
+    scene_args(st)
+    st.add_argument("--out", type=Path, help="output folder (default out/<scene name>_study)")
+    st.add_argument("--no-figures", action="store_true", help="skip PNG plots")
+
     sub.add_parser("machines", help="list the machine parameter files")
     return p
 
@@ -95,6 +102,17 @@ def main(argv: list[str] | None = None) -> int:
             scene = load_scene(args.scene, args.overrides)
             sections = check(scene)
             print(f"{args.scene}: ok ({', '.join(sections)})")
+            return 0
+        if args.command == "study":
+            from .report.study_scene import simplification_study
+            from .scene import load_scene
+
+            scene = load_scene(args.scene, args.overrides)
+            out_dir = args.out if args.out is not None else Path("out") / f"{scene.name}_study"
+            res = simplification_study(scene, out_dir, figures=not args.no_figures,
+                                       log=lambda m: print(m, file=sys.stderr))
+            print(res["summary"])
+            print(f"study: {out_dir}")
             return 0
         if args.command == "machines":
             from .resources import list_machines

@@ -53,6 +53,7 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
     mode = "wb" if isinstance(data, bytes) else "w"
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a result is an ordinary file
         with os.fdopen(fd, mode) as fh:
             fh.write(data)
             fh.flush()
@@ -65,6 +66,12 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
             pass
         raise
     return path
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def write_json_atomic(path: str | Path, results: dict) -> Path:

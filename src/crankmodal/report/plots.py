@@ -1,0 +1,195 @@
+"""Report figures with matplotlib (Agg), each PNG written with its data as a CSV next to it.
+
+- :func:`plot_error_vs_time`: estimated error against wall time, log–log, one point per model,
+  Pareto front and recommendation marked, tolerance drawn;
+- :func:`plot_convergence`: frequency of each mode against DOF per (fidelity, order);
+- :func:`plot_mac`: MAC matrix heat map with values;
+- :func:`plot_participation`: effective-mass fractions per mode (x, y, z translations).
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+_MARKERS = {"full": "o", "dechamfered": "s", "simplified": "^", "imported": "D"}
+_COLOURS = {1: "tab:blue", 2: "tab:red"}
+
+
+def _figure(figsize=(7.0, 4.8)):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=figsize, constrained_layout=True)
+    return plt, fig, ax
+
+
+def _write_csv(path: Path, header, rows) -> Path:
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        w.writerows(rows)
+    return path
+
+
+def plot_error_vs_time(study, path) -> Path:
+    """Error against run time (log–log) of a :class:`~.study.SimplificationStudy`.
+
+    Writes ``path`` (PNG) and ``path`` with ``.csv``: label, fidelity, order, mesh size (m),
+    elements, wall time (s), error, on the front, recommended.
+    """
+    path = Path(path)
+    runs = study.runs
+    t = np.array([r["wall_time_s"] for r in runs])
+    e = np.array([r["error"] for r in runs])
+    floor = max(1e-6, 0.3 * e[e > 0].min()) if np.any(e > 0) else 1e-6
+    ep = np.maximum(e, floor)  # a zero error cannot sit on a log axis
+    plt, fig, ax = _figure()
+    seen = set()
+    for i, r in enumerate(runs):
+        key = (r["fidelity"], r["order"])
+        ax.scatter(t[i], 100 * ep[i], marker=_MARKERS.get(r["fidelity"], "x"),
+                   color=_COLOURS.get(r["order"], "k"), s=46, zorder=3,
+                   label=f"{r['fidelity']} P{r['order']}" if key not in seen else None)
+        seen.add(key)
+        ax.annotate(f"{1e3 * r['mesh_size']:.3g}", (t[i], 100 * ep[i]), textcoords="offset points",
+                    xytext=(5, 4), fontsize=7, color="0.35")
+    fr = np.asarray(study.pareto, int)
+    if len(fr):
+        ax.step(t[fr], 100 * ep[fr], where="post", color="k", lw=1.2, ls="--", zorder=2,
+                label="Pareto front")
+    ax.axhline(100 * study.tolerance, color="tab:green", lw=1.0,
+               label=f"tolerance {100 * study.tolerance:.3g} %")
+    if study.recommended is not None:
+        k = study.recommended
+        ax.scatter(t[k], 100 * ep[k], s=260, facecolors="none", edgecolors="tab:green", lw=2,
+                   zorder=4, label="recommended")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time to mesh and solve, s")
+    ax.set_ylabel(f"estimated error (max over {study.compared_modes} modes), %")
+    ax.set_title("Error against run time (labels: mesh size, mm)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    _write_csv(path.with_suffix(".csv"),
+               ["label", "fidelity", "order", "mesh_size_m", "n_elements", "wall_time_s", "error",
+                "pareto", "recommended"],
+               [[study.label(r), r["fidelity"], r["order"], r["mesh_size"], r["n_elements"],
+                 f"{r['wall_time_s']:.4g}", f"{r['error']:.6g}", int(i in study.pareto),
+                 int(i == study.recommended)] for i, r in enumerate(runs)])
+    return path
+
+
+def plot_convergence(runs, path, reference_hz=None, n_modes: int | None = None) -> Path:
+    """Frequency of each mode against DOF, one line per (fidelity, order) and mode.
+
+    Parameters
+    ----------
+    runs : list of dict
+        ``fidelity``, ``order``, ``n_dofs``, ``frequencies_hz``, ``mesh_size``.
+    reference_hz : sequence, optional
+        Drawn as dotted horizontal lines (the extrapolated values).
+    """
+    path = Path(path)
+    n = n_modes or min(len(r.get("matched_hz", r["frequencies_hz"])) for r in runs)
+    plt, fig, ax = _figure((7.5, 5.2))
+    groups = {}
+    for r in runs:
+        groups.setdefault((r["fidelity"], r["order"]), []).append(r)
+    rows = []
+    cmap = plt.get_cmap("tab10")
+    for (fid, order), rs in groups.items():
+        rs = sorted(rs, key=lambda r: r["n_dofs"])
+        dofs = [r["n_dofs"] for r in rs]
+        for k in range(n):
+            ax.plot(dofs, [r.get("matched_hz", r["frequencies_hz"])[k] for r in rs],
+                    marker=_MARKERS.get(fid, "x"),
+                    color=cmap(k % 10), ls="-" if order == 2 else ":", ms=4)
+        for r in rs:
+            rows.append([fid, order, r["mesh_size"], r["n_dofs"]]
+                        + [f"{f:.6g}" for f in r.get("matched_hz", r["frequencies_hz"])[:n]])
+    if reference_hz is not None:
+        for k, f in enumerate(reference_hz[:n]):
+            ax.axhline(f, color=cmap(k % 10), lw=0.8, ls="--", alpha=0.6)
+    ax.set_xscale("log")
+    ax.set_xlabel("degrees of freedom")
+    ax.set_ylabel("natural frequency, Hz")
+    ax.set_title("Frequency against DOF (colour: mode; dashed: extrapolated reference)")
+    ax.grid(True, which="both", alpha=0.3)
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color="k", marker=_MARKERS.get(fid, "x"),
+                      ls="-" if order == 2 else ":", label=f"{fid} P{order}")
+               for fid, order in groups]  # black: colour stands for the mode
+    ax.legend(handles=handles, fontsize=8, title="colour: mode", title_fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    _write_csv(path.with_suffix(".csv"), ["fidelity", "order", "mesh_size_m", "n_dofs"]
+               + [f"f{k + 1}_hz" for k in range(n)], rows)
+    return path
+
+
+def plot_mac(mac, path, row_labels=None, col_labels=None, title="MAC",
+             xlabel="reference modes", ylabel="modes") -> Path:
+    """MAC heat map (0 white .. 1 dark) with each value printed; CSV of the matrix."""
+    path = Path(path)
+    mac = np.asarray(mac, float)
+    m, k = mac.shape
+    rl = row_labels or [str(i + 1) for i in range(m)]
+    cl = col_labels or [str(j + 1) for j in range(k)]
+    plt, fig, ax = _figure((max(4.8, 1.8 + 0.55 * k), max(3.8, 1.6 + 0.5 * m)))
+    im = ax.imshow(mac, cmap="Blues", vmin=0.0, vmax=1.0)
+    for i in range(m):
+        for j in range(k):
+            ax.text(j, i, f"{mac[i, j]:.2f}", ha="center", va="center", fontsize=7,
+                    color="white" if mac[i, j] > 0.6 else "black")
+    ax.set_xticks(range(k), cl, rotation=90, fontsize=7)
+    ax.set_yticks(range(m), rl, fontsize=7)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    fig.colorbar(im, ax=ax, shrink=0.8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    _write_csv(path.with_suffix(".csv"), [""] + list(cl),
+               [[r] + [f"{v:.6f}" for v in row] for r, row in zip(rl, mac)])
+    return path
+
+
+def plot_participation(frequencies_hz, effective_mass, total_mass, path) -> Path:
+    """Effective-mass fractions (x, y, z translation) per mode and their cumulative sums.
+
+    Parameters
+    ----------
+    frequencies_hz : array_like, shape (n,)
+    effective_mass : ndarray, shape (n, 6)
+        kg for the first three columns (translations).
+    total_mass : float
+        kg.
+    """
+    path = Path(path)
+    f = np.asarray(frequencies_hz, float)
+    frac = np.asarray(effective_mass, float)[:, :3] / total_mass
+    plt, fig, ax = _figure((7.5, 4.5))
+    x = np.arange(len(f))
+    for c, name in enumerate("xyz"):
+        ax.bar(x + (c - 1) * 0.27, 100 * frac[:, c], width=0.27, label=f"{name} translation")
+        ax.plot(x, 100 * np.cumsum(frac[:, c]), marker=".", lw=1,
+                label=f"{name} cumulative")
+    ax.set_xticks(x, [f"{k + 1}\n{v:.0f} Hz" for k, v in enumerate(f)], fontsize=7)
+    ax.set_ylabel("effective mass, % of total")
+    ax.set_title("Mode participation: effective mass per mode and cumulative")
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    _write_csv(path.with_suffix(".csv"), ["mode", "frequency_hz", "x_fraction", "y_fraction",
+                                          "z_fraction"],
+               [[k + 1, f"{v:.6g}"] + [f"{q:.6g}" for q in frac[k]] for k, v in enumerate(f)])
+    return path

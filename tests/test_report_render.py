@@ -1,0 +1,117 @@
+"""Off-screen renders: outward boundary surface (divergence theorem), non-trivial PNGs, GIF, sheet."""
+
+import numpy as np
+import pytest
+
+from crankmodal.fem import testparts
+from crankmodal.report.render import boundary_surface, part_camera
+
+pytest.importorskip("pyvista")
+
+
+def _image(path):
+    from PIL import Image
+
+    return np.asarray(Image.open(path).convert("RGB"))
+
+
+def _surface_integrals(surf):
+    p = surf.points[surf.faces]
+    n = 0.5 * np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])  # area-weighted normals
+    area = np.linalg.norm(n, axis=1).sum()
+    volume = np.einsum("ij,ij->", p.mean(axis=1), n) / 3.0  # ∮ x·n dA / 3
+    return area, volume
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_bar_surface_has_exact_area_and_encloses_exact_volume_so_faces_point_outwards(order):
+    L, b, h = 0.3, 0.04, 0.02
+    part = testparts.bar(L, b, h, divisions=(6, 2, 1), order=order)
+    surf = boundary_surface(part.mesh.points, part.mesh.cells[0].data)
+    area, volume = _surface_integrals(surf)
+    assert area == pytest.approx(2 * (L * b + L * h + b * h), rel=1e-12)
+    assert volume == pytest.approx(L * b * h, rel=1e-12)  # negative if any face were inverted
+    assert surf.points.shape[0] == 7 * 3 * 2  # one element thick: every grid node is on it
+
+
+def test_p2_tube_is_drawn_through_corner_nodes_only():
+    part = testparts.tube(0.05, 0.1, 0.1, divisions=(2, 16, 2), order=2)
+    surf = boundary_surface(part.mesh.points, part.mesh.cells[0].data)
+    corners = np.unique(part.mesh.cells[0].data[:, :4])
+    assert set(surf.node_ids) <= set(corners)
+    _, volume = _surface_integrals(surf)
+    # a 16-gon tube: the polygon areas, not the circle's (exact for flat corner facets)
+    poly = 0.5 * 16 * np.sin(2 * np.pi / 16)
+    assert volume == pytest.approx(poly * (0.1 ** 2 - 0.05 ** 2) * 0.1, rel=1e-12)
+
+
+@pytest.fixture(scope="module")
+def bar_modes():
+    from crankmodal.fem.assembly import assemble
+    from crankmodal.fem.materials import material
+    from crankmodal.fem.modal import solve_modes
+
+    part = testparts.bar(0.3, 0.03, 0.02, divisions=(16, 2, 2), order=2)
+    return part, solve_modes(assemble(part, material("steel")), 3)
+
+
+def test_mode_render_is_a_non_blank_png_of_the_asked_size_with_a_colour_ramp(tmp_path, bar_modes):
+    from crankmodal.report.render import render_modes
+
+    part, modes = bar_modes
+    out = render_modes(part.mesh.points, part.mesh.cells[0].data, modes.frequencies_hz[:2],
+                       modes.shapes[:, :2], tmp_path, labels=["bending about y", "bending about z"],
+                       window_size=(400, 300))
+    img = _image(out["modes"][0])
+    assert img.shape == (300, 400, 3)
+    not_white = np.any(img < 235, axis=2).mean()
+    assert 0.05 < not_white < 0.9  # the part fills a real share of the picture, not all of it
+    colours = np.unique(img.reshape(-1, 3) // 16, axis=0)
+    assert len(colours) > 40  # a colour map, shading and text, not a flat fill
+    # turbo: both ends of the ramp appear (a bending mode has nodes ~0 and ends at the max)
+    reds = np.sum((img[..., 0] > 150) & (img[..., 1] < 90) & (img[..., 2] < 90))
+    blues = np.sum((img[..., 2] > 120) & (img[..., 0] < 90))
+    assert reds > 50 and blues > 50
+    sheet = _image(out["sheet"])
+    assert sheet.shape[1] == 2 * 512  # two modes side by side
+
+
+def test_the_same_part_gets_the_same_camera_whatever_the_mode():
+    part = testparts.bar(0.3, 0.03, 0.02, divisions=(4, 1, 1), order=1)
+    a = part_camera(part.mesh.points)
+    b = part_camera(part.mesh.points.copy())
+    assert a == b
+    view = np.subtract(a["position"], a["focal_point"])
+    assert abs(view @ np.array(a["view_up"])) < 1e-12 * np.linalg.norm(view)
+
+
+def test_gif_has_one_frame_per_step_and_the_shape_swings_both_ways(tmp_path, bar_modes):
+    from PIL import Image
+
+    from crankmodal.report.render import animate_mode
+
+    part, modes = bar_modes
+    surf = boundary_surface(part.mesh.points, part.mesh.cells[0].data)
+    path = animate_mode(surf, modes.shapes[:, 0], tmp_path / "m.gif", "mode 1",
+                        part_camera(surf.points), n_frames=4, window_size=(200, 150))
+    im = Image.open(path)
+    assert im.n_frames == 4
+    frames = []
+    for k in range(4):
+        im.seek(k)
+        frames.append(np.asarray(im.convert("RGB"), int))
+    assert np.abs(frames[1] - frames[3]).sum() > 0  # +max and -max differ
+
+
+def test_von_mises_render_of_a_linear_field_shows_the_whole_jet_ramp(tmp_path):
+    from crankmodal.report.render import render_scalar
+
+    part = testparts.bar(0.3, 0.03, 0.02, divisions=(10, 2, 2), order=1)
+    surf = boundary_surface(part.mesh.points, part.mesh.cells[0].data)
+    stress = 1e8 * part.mesh.points[:, 0] / 0.3  # 0 .. 100 MPa along the bar
+    path = render_scalar(surf, stress, tmp_path / "vm.png", "von Mises", part_camera(surf.points),
+                         window_size=(400, 300))
+    img = _image(path).astype(int)
+    reds = np.sum((img[..., 0] > 180) & (img[..., 1] < 80) & (img[..., 2] < 80))
+    blues = np.sum((img[..., 2] > 150) & (img[..., 0] < 60) & (img[..., 1] < 80))
+    assert reds > 100 and blues > 100
