@@ -14,7 +14,7 @@ from crankmodal.runner import check, run
 from crankmodal.scene import load_scene, scene_from_dict
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
-FOUR_STAR = SCENES / "four_star_compressor.toml"
+FOUR_STAR = SCENES / "four_star_mechanism.toml"
 ENGINE = SCENES / "slider_crank_engine.toml"
 
 

@@ -141,3 +141,12 @@ def test_measured_modes_place_each_measured_value_at_its_computed_mode(tmp_path)
         measured_by_mode([780.0, 1115.0], [1, 1])
     with pytest.raises(SceneError, match="report.measured_modes: needs report.measured_hz"):
         measured_by_mode(None, [1])
+
+
+def test_markdown_cells_with_a_bar_keep_the_table_columns():
+    from crankmodal.report.modal_report import Report
+
+    rep = Report("t")
+    rep.table(["section", "summary"], [["[mechanism]", "|F1| 2959 N"]])
+    row = [ln for ln in rep.to_markdown().splitlines() if ln.startswith("| [mechanism]")][0]
+    assert row.replace("\\|", "").count("|") == 3  # two cells: three unescaped bars

@@ -104,7 +104,7 @@ def _cell(c) -> str:
         return "–"
     if isinstance(c, (float, np.floating)):
         return f"{c:.4g}"
-    return str(c)
+    return str(c).replace("|", "\\|")  # a literal bar would split the Markdown cell
 
 
 def versions() -> dict:
