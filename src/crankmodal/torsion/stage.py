@@ -233,8 +233,44 @@ def run(p: dict, ctx) -> dict:
     }
     if model is not None:
         res["crank_model"] = model.to_dict()
+    beside = beside_cad_and_fe(res, ctx)
+    if beside:
+        res.update(beside)
     res["summary"] = _summary(res, crit)
     return res
+
+
+def beside_cad_and_fe(res: dict, ctx) -> dict:
+    """The CAD polar inertia and the first FE torsional mode of the scene's own crank, if any.
+
+    When the scene also has ``[geometry]`` (a crankshaft, axis z) and ``[material]``, the polar
+    inertia of the CAD solid about the shaft axis is put beside the lumped model's solid parts
+    (crankpins, webs, flywheel; the reciprocating and rod equivalents are not in the CAD). When it
+    has ``[modal]``, the first mode the FE classifier calls torsion is put beside the two-rotor,
+    Holzer and exact-chain frequencies.
+    """
+    from .fe_compare import compare_with_fe
+    from .inertias import inertia_about_axis
+
+    out = {}
+    part, mat = ctx.products.get("geometry"), ctx.products.get("material")
+    if getattr(part, "cad_mass", None) is not None and hasattr(mat, "rho"):
+        cad = {"cad_polar_inertia_kgm2": inertia_about_axis(part.cad_mass, mat.rho, (0, 0, 0),
+                                                            (0, 0, 1)),
+               "part": part.name}
+        model = res.get("crank_model")
+        if model:
+            t = model["throw_inertias_kgm2"]
+            n_throws = ctx.params.get("torsion", {}).get("n_throws") or 1
+            lumped = n_throws * (t["crankpin"] + t["webs"]) + model["flywheel_inertia_kgm2"]
+            cad["lumped_solid_inertia_kgm2"] = lumped
+            cad["lumped_vs_cad"] = lumped / cad["cad_polar_inertia_kgm2"] - 1.0
+        out["cad_inertia"] = cad
+    modal = ctx.results.get("modal")
+    if modal and modal.get("classes"):
+        classes = ["torsion" if c.startswith("torsion") else "other" for c in modal["classes"]]
+        out["fe_comparison"] = compare_with_fe(res, modal["frequencies_hz"], classes)
+    return out
 
 
 def _summary(res: dict, crit) -> str:
