@@ -245,7 +245,8 @@ def beside_cad_and_fe(res: dict, ctx) -> dict:
 
     When the scene also has ``[geometry]`` (a crankshaft, axis z) and ``[material]``, the polar
     inertia of the CAD solid about the shaft axis is put beside the lumped model's solid parts
-    (crankpins, webs, flywheel; the reciprocating and rod equivalents are not in the CAD). When it
+    (crankpins, webs, flywheel; the reciprocating and rod equivalents are not in the CAD), in
+    total and per rotor (the mesh cut at the flywheel's crank-side face). When it
     has ``[modal]``, the first mode the FE classifier calls torsion is put beside the two-rotor,
     Holzer and exact-chain frequencies.
     """
@@ -265,6 +266,21 @@ def beside_cad_and_fe(res: dict, ctx) -> dict:
             lumped = n_throws * (t["crankpin"] + t["webs"]) + model["flywheel_inertia_kgm2"]
             cad["lumped_solid_inertia_kgm2"] = lumped
             cad["lumped_vs_cad"] = lumped / cad["cad_polar_inertia_kgm2"] - 1.0
+            fw = part.regions.get("flywheel_face")
+            if fw is not None:  # per rotor: cut the meshed solid at the flywheel's crank-side face
+                from .mesh_inertias import slab_axial_inertias
+
+                pts = part.mesh.points
+                z_cut = float(pts[fw.nodes, 2].mean())
+                slabs = slab_axial_inertias(pts, part.mesh.cells[0].data, mat.rho, [z_cut],
+                                            (0, 0, 0), (0, 0, 1))
+                cad["rotors"] = [
+                    {"rotor": "throws (with journals and stubs)", "cut_z_m": z_cut,
+                     "cad_kgm2": float(slabs[0]),
+                     "lumped_kgm2": n_throws * (t["crankpin"] + t["webs"])},
+                    {"rotor": "flywheel", "cut_z_m": z_cut, "cad_kgm2": float(slabs[1]),
+                     "lumped_kgm2": model["flywheel_inertia_kgm2"]},
+                ]
         out["cad_inertia"] = cad
     modal = ctx.results.get("modal")
     if modal and modal.get("classes"):
