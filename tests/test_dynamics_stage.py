@@ -95,3 +95,16 @@ def test_machine_defaults_build_the_seed_loom_four_bar(tmp_path):
     assert params["clearances"][0]["clearance"] == pytest.approx(2.1e-5)
     res = run(_scene(data), tmp_path, figures=False)["dynamics"]
     assert res["mechanism"] == "four_bar" and res["energy_balance_error"] < 1e-3
+
+
+def test_film_model_is_a_scene_key_that_reaches_the_joint(tmp_path):
+    from crankmodal.dynamics.build import build_mechanism
+
+    data = {"dynamics": {"machine": "loom_four_bar", "end_time": 0.02, "run_ideal": False}}
+    scene = scene_from_dict(data, overrides=["dynamics.clearances.0.film_model=finite"])
+    params = check(scene)["dynamics"]
+    assert params["clearances"][0]["film_model"] == "finite"
+    joints = build_mechanism(params).system.clearances
+    assert [j.film_model for j in joints] == ["finite"]
+    with pytest.raises(SceneError, match=r"film_model: must be one of short, finite; got 'long'"):
+        check(scene_from_dict(data, overrides=["dynamics.clearances.0.film_model=long"]))

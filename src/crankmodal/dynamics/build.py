@@ -27,7 +27,8 @@ def contact_arguments(p) -> tuple[dict, dict]:
         spec = {"clearance": cl["clearance"], "journal_radius": cl["journal_radius"],
                 "clearance_major": cl["clearance_major"],
                 "wear_angle": float(np.deg2rad(cl["wear_angle_deg"])),
-                "viscosity": cl["viscosity"], "bearing_length": cl["bearing_length"] or 0.0}
+                "viscosity": cl["viscosity"], "bearing_length": cl["bearing_length"] or 0.0,
+                "film_model": cl["film_model"]}
         if c["stiffness"] is None:
             rj = cl["journal_radius"]
             K = contact.cylinder_stiffness(rj, rj + cl["clearance"], c["E"], c["nu"], c["E"], c["nu"])

@@ -16,6 +16,8 @@ import numpy as np
 from . import contact
 from .lubrication import short_bearing_force
 
+FILM_MODELS = ("short", "finite")
+
 
 @dataclass
 class ClearanceJoint:
@@ -54,6 +56,10 @@ class ClearanceJoint:
         :mod:`.lubrication` (round bores only); None for a dry joint.
     bearing_length : float
         Bearing length for the film force, m.
+    film_model : str
+        ``"short"``: short-bearing (Ocvirk) pi film of :mod:`.lubrication`; ``"finite"``:
+        finite-length Reynolds film with Reynolds cavitation, tabulated per ``L/D`` by
+        :mod:`.reynolds` (the first use of an ``L/D`` costs a few seconds).
     eps_max : float
         Eccentricity ratio at which the film force stops growing (the dry contact law takes
         over at ``eps = 1``); keeps the film's ``(1 - eps^2)^-5/2`` finite.
@@ -75,6 +81,7 @@ class ClearanceJoint:
     wear_angle: float = 0.0
     viscosity: float | None = None
     bearing_length: float = 0.0
+    film_model: str = "short"
     eps_max: float = 0.95
     # contact memory (restitution laws): impact velocity of the current contact
     v_impact: float = 1e-3
@@ -121,16 +128,23 @@ class ClearanceJoint:
         drho = -a * b * (a * a - b * b) * sn * cs / s2**1.5
         return float(rho - self.journal_radius), float(drho)
 
+    def __post_init__(self):
+        if self.film_model not in FILM_MODELS:
+            raise ValueError(f"film_model must be one of {FILM_MODELS}; got {self.film_model!r}")
+
     def film_force(self, k) -> np.ndarray:
-        """Short-bearing film force on the journal (global x, y), N."""
+        """Film force on the journal (global x, y), N (``film_model``: short or finite)."""
         c = self.clearance
         d = k["d"]
         eps = min(d / c, self.eps_max)
         n, t = k["n"], k["t"]
         gamma_dot = float(t @ k["vrel"]) / d if d > 1e-12 * c else 0.0
-        fr, ftan = short_bearing_force(eps, float(n @ k["vrel"]) / c, gamma_dot, k["omega_sum"],
-                                       self.viscosity, self.journal_radius, self.bearing_length,
-                                       c)
+        if self.film_model == "finite":
+            from .reynolds import finite_bearing_force as law
+        else:
+            law = short_bearing_force
+        fr, ftan = law(eps, float(n @ k["vrel"]) / c, gamma_dot, k["omega_sum"], self.viscosity,
+                       self.journal_radius, self.bearing_length, c)
         return float(fr) * n + float(ftan) * t
 
     def gap(self, sysm, q) -> float:

@@ -86,6 +86,7 @@ def _split(pins, clearance_specs, contact_kw):
             clearance=spec["clearance"], journal_radius=spec["journal_radius"],
             clearance_major=spec.get("clearance_major"), wear_angle=spec.get("wear_angle", 0.0),
             viscosity=spec.get("viscosity"), bearing_length=spec.get("bearing_length", 0.0),
+            film_model=spec.get("film_model", "short"),
             **kw))
     unknown = set(clearance_specs) - {p.name for p in pins}
     if unknown:

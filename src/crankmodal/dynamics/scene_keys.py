@@ -97,6 +97,8 @@ CLEARANCE = {
     "viscosity": Field("float", None, "lubricant dynamic viscosity, Pa s: adds the short-bearing "
                        "(Ocvirk) film force", gt=0.0),
     "bearing_length": Field("float", None, "bearing length for the film force, m", gt=0.0),
+    "film_model": Field("str", "short", "film force with viscosity: short (Ocvirk) or finite "
+                        "(Reynolds, tabulated per L/D)", choices=("short", "finite")),
 }
 
 CONTACT = {

@@ -1,0 +1,195 @@
+"""Finite-length journal bearing (Reynolds equation with cavitation) against its limits, the
+Raimondi-Boyd L/D = 1 chart, seed 001 Table 3, and in a dynamics run."""
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from crankmodal.dynamics import SolverSettings, four_bar, simulate
+from crankmodal.dynamics.bodies import Ground, RigidBody
+from crankmodal.dynamics.clearance import ClearanceJoint
+from crankmodal.dynamics.lubrication import short_bearing_force
+from crankmodal.dynamics.reynolds import (
+    finite_bearing_force,
+    solve_pressure,
+    steady_bearing,
+)
+from crankmodal.dynamics.simulate import integrate
+from crankmodal.dynamics.system import Multibody
+
+MU, R, L, C = 0.0175, 0.02, 0.042, 2.1e-5   # seed 001 Table 2 (L/D = 1.05)
+EPS = (0.2, 0.5, 0.8)
+
+
+@pytest.mark.parametrize("eps", EPS)
+def test_finite_rotation_film_tends_to_the_ocvirk_short_bearing_as_length_vanishes(eps):
+    # Oracle: lubrication.short_bearing_force (closed form, pi film). The finite solution
+    # misses it by O((L/D)^2): measured 0.5 / 1.0 / 3.2 % at L/D = 0.1 and 0.16 / 0.28 / 0.82 %
+    # at L/D = 0.05 for eps = 0.2 / 0.5 / 0.8.
+    w = 150.0
+    errors = []
+    for ld in (0.1, 0.05):
+        length = 2 * R * ld
+        f = solve_pressure(eps, ld, rotation=w)[2] * MU * R * length * (R / C) ** 2
+        ref = np.array(short_bearing_force(eps, 0.0, 0.0, w, MU, R, length, C))
+        errors.append(np.hypot(*(f - ref)) / np.hypot(*ref))
+    assert errors[1] < 0.01
+    assert errors[1] < 0.5 * errors[0]          # converging as L/D -> 0
+
+
+@pytest.mark.parametrize("eps", EPS)
+def test_finite_squeeze_film_tends_to_the_cavitated_short_bearing_squeeze(eps):
+    # Oracle: short-bearing pure squeeze with Reynolds cavitation, pressure
+    # 6 cos(theta) (1 - zeta^2) (L/D)^2 / H^3 where positive: f_r = -/+ 4 (L/D)^2
+    # int cos^2 / (1 - eps cos)^3 over the squeezed half (approach / separation).
+    ld = 0.05
+    g = lambda t: np.cos(t) ** 2 / (1 - eps * np.cos(t)) ** 3
+    approach = -4 * ld**2 * quad(g, -np.pi / 2, np.pi / 2)[0]
+    separation = 4 * ld**2 * quad(g, np.pi / 2, 3 * np.pi / 2)[0]
+    fa = solve_pressure(eps, ld, 0.0, 1.0, inlet="free")[2]
+    fs = solve_pressure(eps, ld, 0.0, -1.0, inlet="free")[2]
+    assert fa[0] == pytest.approx(approach, rel=0.01)
+    assert fs[0] == pytest.approx(separation, rel=0.01)
+    assert abs(fa[1]) < 1e-9 * abs(approach) and abs(fs[1]) < 1e-9 * abs(separation)
+
+
+@pytest.mark.parametrize("eps", EPS)
+def test_half_sommerfeld_finite_bearing_tends_to_the_long_bearing_closed_form(eps):
+    # Oracle: infinitely long bearing, half-Sommerfeld (Hamrock, Fundamentals of Fluid Film
+    # Lubrication): f_r = 12 eps^2 / ((2 + eps^2)(1 - eps^2)),
+    # f_t = 6 pi eps / ((2 + eps^2) sqrt(1 - eps^2)) per mu omega R L / psi^2. The end leakage
+    # error falls as D/L (3 % at L/D = 32): Richardson extrapolation of L/D = 16 and 32
+    # (96 nodes over the half length, to resolve the end zone) within 0.5 % (load) and
+    # 0.1 deg (attitude angle); measured <= 0.15 % and 0.04 deg.
+    fr = 12 * eps**2 / ((2 + eps**2) * (1 - eps**2))
+    ft = 6 * np.pi * eps / ((2 + eps**2) * np.sqrt(1 - eps**2))
+    b16, b32 = (steady_bearing(eps, ld, n_zeta=96, cavitation="half_sommerfeld")
+                for ld in (16.0, 32.0))
+    assert 2 * b32.load - b16.load == pytest.approx(np.hypot(fr, ft), rel=0.005)
+    assert 2 * b32.attitude_deg - b16.attitude_deg == pytest.approx(
+        np.degrees(np.arctan2(ft, fr)), abs=0.1)
+
+
+def test_reynolds_solution_converges_at_second_order_under_mesh_refinement():
+    # Oracle: self-convergence; differences of successive meshes shrink by ~4 (h^2).
+    loads = [steady_bearing(0.6, 1.0, n_theta=n, n_zeta=n // 6).load for n in (48, 96, 192)]
+    d1, d2 = abs(loads[1] - loads[0]), abs(loads[2] - loads[1])
+    assert 2.5 < d1 / d2 < 6.0
+    assert d2 < 2e-3 * loads[2]
+
+
+# Raimondi & Boyd (1958), full journal bearing, L/D = 1 (as tabulated in Shigley's Mechanical
+# Engineering Design): eps, Sommerfeld number S, attitude angle (deg). Their oil enters at
+# ambient pressure on the line of maximum film (inlet="max_film"), Reynolds condition at the
+# film end.
+RAIMONDI_BOYD = [(0.1, 1.33, 79.5), (0.2, 0.631, 74.02), (0.4, 0.264, 63.10),
+                 (0.6, 0.121, 50.58), (0.8, 0.0446, 36.24), (0.9, 0.0188, 26.45)]
+
+
+@pytest.mark.parametrize("eps,S,phi", RAIMONDI_BOYD)
+def test_finite_bearing_at_unit_length_ratio_reproduces_raimondi_boyd(eps, S, phi):
+    # Tolerance 2 % in S and 0.6 deg: the chart's own accuracy (hand relaxation); measured
+    # worst 1.3 % and 0.53 deg, both at eps = 0.4, the others within 0.2 % and 0.2 deg.
+    b = steady_bearing(eps, 1.0)
+    assert b.sommerfeld == pytest.approx(S, rel=0.02)
+    assert b.attitude_deg == pytest.approx(phi, abs=0.6)
+
+
+def test_finite_bearing_is_closer_than_the_short_bearing_to_seed_001_table_3_load():
+    # Seed 001 Table 3 (L/D = 1): dimensionless film force F psi^2 / (mu U L) and attitude
+    # angle for eps = 0.1 .. 0.7. The table's source and boundary conditions are not given;
+    # it lies 11..18 % below Raimondi-Boyd (and this solver) in load and 4..13 deg below in
+    # attitude angle, so the stated tolerance is 25 % of the table load and 13 deg, and the
+    # finite bearing must beat Ocvirk's short bearing in load (the short bearing
+    # overestimates the table by 63..164 %; its angles are 2..13 deg high).
+    eps = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])
+    load = np.array([0.197, 0.415, 0.680, 1.029, 1.524, 2.296, 3.654])
+    phi = np.array([75.11, 63.59, 55.55, 50.08, 45.32, 40.54, 36.02])
+    s = 1 - eps**2
+    short = eps * np.sqrt(16 * eps**2 + np.pi**2 * s) / s**2       # (L/D)^2 = 1
+    fin = [steady_bearing(e, 1.0) for e in eps]
+    fl = np.array([b.load for b in fin])
+    np.testing.assert_allclose(fl, load, rtol=0.25)
+    np.testing.assert_allclose([b.attitude_deg for b in fin], phi, atol=13.0)
+    assert np.all(np.abs(fl - load) < np.abs(short - load))
+
+
+STATES = [  # eps, eps_dot (1/s), gamma_dot (rad/s), omega (rad/s)
+    (0.13, 0.0, 0.0, 100.0), (0.3, 20.0, 0.0, 100.0), (0.6, -20.0, 0.0, 100.0),
+    (0.85, -37.0, 13.0, -50.0), (0.85, 7.0, 0.0, 0.0), (0.95, 100.0, 0.0, 100.0)]
+
+
+@pytest.mark.parametrize("eps,eps_dot,gamma_dot,omega", STATES)
+def test_tabulated_dynamic_film_force_equals_a_direct_solve_with_squeeze(eps, eps_dot,
+                                                                        gamma_dot, omega):
+    # Oracle: the full Reynolds problem with the squeeze term, solved directly on a finer
+    # mesh (144 x 24 against the table's 96 x 16); tolerance 1.5 % of the force (measured
+    # <= 0.2 % except separation at eps >= 0.85: 0.5 .. 1.3 %).
+    f = np.array(finite_bearing_force(eps, eps_dot, gamma_dot, omega, MU, R, L, C))
+    ref = solve_pressure(eps, L / (2 * R), omega - 2 * gamma_dot, eps_dot, inlet="free")[2]
+    ref = ref * MU * R * L * (R / C) ** 2
+    assert np.hypot(*(f - ref)) < 0.015 * np.hypot(*ref)
+
+
+def test_loaded_spinning_journal_settles_at_the_steady_finite_bearing_equilibrium():
+    # Oracle: the direct steady solve; the load W = m g, omega = 200 rad/s give
+    # F psi^2 / (mu omega R L) = 7.5, i.e. eps = 0.8023 at 36.9 deg from the load. The
+    # dynamics run (tabulated force, squeeze and whirl terms) must settle there: eps within
+    # 0.5 %, angle within 0.3 deg, no dry contact, energy balance closed.
+    G, w = 20000.0, 200.0
+    ground = Ground(frames={"bore": (0.0, 0.0)})
+    journal = RigidBody("journal", 1.0, 1e-3, {"centre": (0.0, 0.0)})
+    joint = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=C, journal_radius=R,
+                           law="hertz", law_params={"stiffness": 1e11, "exponent": 1.5},
+                           viscosity=MU, bearing_length=L, film_model="finite")
+    sysm = Multibody([journal], [], [joint], gravity=(0.0, -G))
+    q0, qd0 = np.zeros(3), np.array([0.0, 0.0, w])
+    out = integrate(sysm, q0, qd0, 0.04, None, SolverSettings(method="LSODA", rtol=1e-7,
+                                                             atol=1e-14))
+    y = out.y[:, -1]
+    assert out.onsets[0] == []
+    X = G * (C / R) ** 2 / (MU * w * R * L)
+    eps = brentq(lambda e: steady_bearing(e, L / (2 * R), inlet="free").load - X, 0.3, 0.95,
+                 xtol=1e-6)
+    phi = steady_bearing(eps, L / (2 * R), inlet="free").attitude_deg
+    assert np.hypot(y[0], y[1]) / C == pytest.approx(eps, rel=0.005)
+    # load along -y, rotation ccw: the journal sits phi ahead of the load direction
+    assert np.degrees(np.arctan2(y[1], y[0])) == pytest.approx(-90.0 + phi, abs=0.3)
+    ke0 = sysm.energy(q0, qd0)
+    ke, pe = sysm.energy(y[:3], y[3:6])
+    assert (ke + pe) - sum(ke0) == pytest.approx(-y[-2], abs=1e-9 * ke0[0])
+
+
+def test_lubricated_loom_coupler_pin_with_finite_film_closes_its_energy_balance():
+    # Seed 001 loom four-bar at 450 rpm, coupler pin C lubricated (Table 2 bearing): the
+    # film carries the pin load (no dry contact) and the energy residual stays < 1e-4.
+    from crankmodal.dynamics.contact import cylinder_stiffness
+
+    loom = {"crank_length": 0.035, "coupler_length": 0.075, "rocker_length": 0.145,
+                "rocker_pivot": (0.008, 0.1598), "masses": (35.8, 2.27, 10.42),
+                "inertias": (0.0155, 0.0114, 0.0528), "extra_rocker_inertia": 0.3728, "speed_rpm": 450.0}
+    K = float(cylinder_stiffness(R, R + C, 2.1e11, 0.3, 2.1e11, 0.3))
+    contact = {"law": "lankarani_nikravesh",
+                   "law_params": {"stiffness": K, "exponent": 1.5, "restitution": 0.7}}
+    m = four_bar(**loom, clearances={"C": {"clearance": C, "journal_radius": R, "viscosity": MU,
+                                           "bearing_length": L}}, contact_kw=contact)
+    (joint,) = m.system.clearances
+    joint.film_model = "finite"
+    w = 450.0 * np.pi / 30
+    T = 0.5 * 60.0 / 450.0
+    s = SolverSettings(method="LSODA", atol=C * 1e-4, max_step=np.deg2rad(2) / w,
+                       velocity_scale=10 * w if 10 * w > 1000 else 1000.0)
+    h = simulate(m, T, T / 180, s)
+    d = h.contact["C"]
+    assert d["fn"].max() == 0.0
+    assert 0.1 < np.hypot(d["ex"], d["ey"]).max() / C < 0.95
+    assert h.energy_error() < 1e-4
+
+
+def test_unknown_film_model_is_rejected_with_the_admissible_values():
+    with pytest.raises(ValueError, match="film_model"):
+        ClearanceJoint("c", None, "a", None, "b", clearance=C, journal_radius=R,
+                       film_model="long")
+    with pytest.raises(ValueError, match="eps"):
+        solve_pressure(1.0, 1.0)
