@@ -41,8 +41,13 @@ def plot_accelerations(res, path):
     ax1.set_title("piston acceleration: exact (solid), 2nd-order series (dashed)")
     ax2.set_ylabel("rod angular acceleration (rad/s$^2$)")
     ax2.set_xlabel("crank angle (deg)")
-    for ax in (ax1, ax2):
-        ax.grid(True, alpha=0.3)
+    _finish(plt, fig, (ax1, ax2), path)
+
+
+def _finish(plt, fig, axes, path, grid="major"):
+    """Grid and legend on every axis, then write the PNG and free the figure."""
+    for ax in axes:
+        ax.grid(True, which=grid, alpha=0.3)
         ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -60,12 +65,7 @@ def plot_gas_force(res, path):
     ax1.set_ylabel("gas force towards the crank (kN)")
     ax2.set_xlabel("cylinder volume (cm$^3$)")
     ax2.set_ylabel("pressure (MPa abs)")
-    for ax in (ax1, ax2):
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _finish(plt, fig, (ax1, ax2), path, grid="both")
 
 
 def plot_piston_forces(res, path):
@@ -78,12 +78,7 @@ def plot_piston_forces(res, path):
     ax1.set_ylabel("piston force (kN)")
     ax2.set_ylabel("side thrust (kN)")
     ax2.set_xlabel("crank angle (deg)")
-    for ax in (ax1, ax2):
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _finish(plt, fig, (ax1, ax2), path)
 
 
 def plot_shaking_polar(res, path):
