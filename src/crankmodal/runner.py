@@ -114,9 +114,8 @@ def run(scene: Scene, out_dir: str | Path, figures: bool = True, log=None) -> di
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "results.json").unlink(missing_ok=True)
-    ctx = StageContext(scene=scene, out_dir=out_dir, params=params, figures=figures)
     results: dict = {"crankmodal_version": __version__, "scene": scene.name}
-    ctx.results = results
+    ctx = StageContext(scene=scene, out_dir=out_dir, params=params, results=results, figures=figures)
     for section, p in params.items():
         if log:
             log(f"[{section}] running")

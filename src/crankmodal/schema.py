@@ -13,7 +13,7 @@ heavy stage dependency.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 from .errors import SceneError
@@ -47,7 +47,7 @@ class Field:
         Value used when the key is absent; ``REQUIRED`` makes the key mandatory; ``None`` means
         optional with no value.
     doc : str
-        One line for the README/`crankmodal keys` listing, with units.
+        What the key means, with units; quoted in the "is required" message.
     gt, ge, lt, le : float, optional
         Bounds on a number (or on every element of a list of numbers).
     choices : tuple, optional
@@ -68,7 +68,6 @@ class Field:
     choices: tuple | None = None
     length: int | None = None
     check: Callable[[Any], str | None] | None = None
-    extra: dict = field(default_factory=dict)
 
 
 def _fail(key: str, message: str) -> SceneError:
@@ -175,12 +174,3 @@ def validate(section: str, raw: Mapping[str, Any], schema: Mapping[str, Field]) 
         else:
             out[name] = f.default
     return out
-
-
-def describe(schema: Mapping[str, Field]) -> list[tuple[str, str, str]]:
-    """Rows ``(key, default, doc)`` for documentation listings."""
-    rows = []
-    for name, f in schema.items():
-        default = "required" if f.default is REQUIRED else repr(f.default)
-        rows.append((name, default, f.doc))
-    return rows
