@@ -27,29 +27,25 @@ from pathlib import Path
 DEFAULT_SIZE = 0.0075  # m: ~285k P2 DOF for the four-star crankshaft
 
 
+#: interfaces of the crankshaft: 2 journals, 2 crankpin rows in 2 bands each, 2 end faces
+CRANK_SPECS = [{"region": "main_journal_1", "segments": 1},
+               {"region": "main_journal_2", "segments": 1},
+               {"region": "crankpin_1_row_1", "segments": 2},
+               {"region": "crankpin_1_row_2", "segments": 2},
+               {"region": "free_end_face", "segments": 1},
+               {"region": "flywheel_end_face", "segments": 1}]
+BAR_SPECS = [{"region": "end_x0", "segments": 1}, {"region": "end_x1", "segments": 1}]
+
+
 def build(size: float):
-    """Part and interface specs: the crankshaft (8 interfaces) or a bar (2)."""
-    try:
-        from crankmodal.geometry import stage as gs
-        from crankmodal.scene import Scene
+    """Part and interface specs: the crankshaft (8 interfaces) or a bar (2).
 
-        p = gs.validate({"machine": "four_star_compressor", "part": "crankshaft",
-                         "fidelity": "full", "mesh_size": size, "element_order": 2},
-                        Scene(name="bench", base_dir=Path(".")))
-        part, _ = gs.make_part(p)
-        specs = [{"region": "main_journal_1", "segments": 1},
-                 {"region": "main_journal_2", "segments": 1},
-                 {"region": "crankpin_1_row_1", "segments": 2},
-                 {"region": "crankpin_1_row_2", "segments": 2},
-                 {"region": "free_end_face", "segments": 1},
-                 {"region": "flywheel_end_face", "segments": 1}]
-        return part, specs, "four_star_compressor/crankshaft"
-    except ImportError:
-        from crankmodal.fem.testparts import bar
+    The part is the modal benchmark's (``modal_bench.py`` in this folder).
+    """
+    from modal_bench import build_part
 
-        n = max(2, round(0.05 / size * 2))
-        part = bar(0.4, 0.05, 0.05, (8 * n, n, n))
-        return part, [{"region": "end_x0", "segments": 1}, {"region": "end_x1", "segments": 1}], "bar"
+    part, _, name = build_part(size)
+    return part, (CRANK_SPECS if "crankshaft" in name else BAR_SPECS), name
 
 
 def one(size: float, coupling: str, n_modes: int, backend: str) -> dict:
@@ -87,22 +83,21 @@ def one(size: float, coupling: str, n_modes: int, backend: str) -> dict:
         basis_s = t_itf + sum(cb.timings.values()) + t_orth
         ru = resource.getrusage(resource.RUSAGE_SELF)
         basis_cpu = ru.ru_utime + ru.ru_stime - cpu0
-        mem_stress = PeakMemory().__enter__()
-        t0 = time.perf_counter()
-        rec = stress_recovery(model, part.mesh)
-        t_rec = time.perf_counter() - t0
-        Vo = cb.V @ ortho.W
-        t0 = time.perf_counter()
-        stress_modes(rec, Vo[:, 6:66], dtype=np.float32)
-        t_s60 = time.perf_counter() - t0
-        ru = resource.getrusage(resource.RUSAGE_SELF)
-        cpu0 = ru.ru_utime + ru.ru_stime
-        t0 = time.perf_counter()
-        stress_modes(rec, Vo, dtype=np.float32)
-        t_sall = time.perf_counter() - t0
-        ru = resource.getrusage(resource.RUSAGE_SELF)
-        sall_cpu = ru.ru_utime + ru.ru_stime - cpu0
-        mem_stress.__exit__(None, None, None)
+        with PeakMemory() as mem_stress:
+            t0 = time.perf_counter()
+            rec = stress_recovery(model, part.mesh)
+            t_rec = time.perf_counter() - t0
+            Vo = cb.V @ ortho.W
+            t0 = time.perf_counter()
+            stress_modes(rec, Vo[:, 6:66], dtype=np.float32)
+            t_s60 = time.perf_counter() - t0
+            ru = resource.getrusage(resource.RUSAGE_SELF)
+            cpu0 = ru.ru_utime + ru.ru_stime
+            t0 = time.perf_counter()
+            stress_modes(rec, Vo, dtype=np.float32)
+            t_sall = time.perf_counter() - t0
+            ru = resource.getrusage(resource.RUSAGE_SELF)
+            sall_cpu = ru.ru_utime + ru.ru_stime - cpu0
     f = ortho.frequencies_hz[~ortho.rigid]
     return {"part": name, "size": size, "coupling": coupling, "backend": cb.backend,
             "n_dofs": int(model.n_dofs), "n_elements": model.n_elements,

@@ -12,6 +12,7 @@ from crankmodal.fem.testparts import bar
 from crankmodal.reduction.craig_bampton import craig_bampton
 from crankmodal.reduction.flexbody import inertia_invariants
 from crankmodal.reduction.interfaces import (
+    distributing_rows,
     interface_rigid_fields,
     make_interfaces,
     tie_transformation,
@@ -147,6 +148,17 @@ def test_orthonormalised_basis_is_m_orthonormal_k_diagonal_with_six_rigid_modes(
     Rb = interface_rigid_fields(itf)
     assert np.allclose(body.interface_map.reshape(-1, body.n_modes), body.cb_to_modal[:12])
     assert Rb.shape == (12, 6)
+    # ... checked against the full field, not against how the map is stored: a rigid surface
+    # follows its node rigidly, a distributing one has it at its mean motion (q = G u)
+    _, G = distributing_rows(model.points, model.cells, itf)
+    for r, i in enumerate(itf):
+        q = body.interface_map[r]  # (6, n)
+        if kind == "rigid":
+            u = Vo.reshape(len(model.points), 3, -1)[i.nodes].reshape(-1, Vo.shape[1])
+            moved = rigid_body_modes(model.points[i.nodes], i.centre) @ q
+            assert np.abs(u - moved).max() < 1e-10 * np.abs(Vo).max()
+        else:
+            assert np.abs(G[6 * r:6 * r + 6] @ Vo - q).max() < 1e-10 * np.abs(q).max()
 
 
 def test_elastic_modes_meet_mean_axis_conditions_and_unit_modal_mass(bar_model):

@@ -268,21 +268,26 @@ def rigid_body_modes(points: np.ndarray, centre=None) -> np.ndarray:
     return R.reshape(3 * n, 6)
 
 
+def mass_and_centre(model: FEModel) -> tuple[float, np.ndarray]:
+    """Mass (kg) and centre of mass (m) from M: ``1ᵀ M_s 1`` and ``1ᵀ M_s x / mass``.
+
+    ``M_s`` is the scalar mass matrix (the x-component rows and columns of M).
+    """
+    Mx = model.M[0::3, 0::3]
+    ones = np.ones(len(model.points))
+    mass = float(ones @ (Mx @ ones))
+    # first moments: Σ_ab M_ab x_b over the x-component rows
+    first = np.array([ones @ (Mx @ model.points[:, k]) for k in range(3)])
+    return mass, first / mass
+
+
 def mass_properties(model: FEModel) -> dict:
     """Mass (kg), centre of mass (m) and inertia tensor about it (kg m²) from M.
 
     ``Rᵀ M R`` of the rigid-body fields is exact for the consistent mass matrix, so this is an
     independent check of M against the CAD's mass properties.
     """
-    R = rigid_body_modes(model.points)
-    T = R[:, :3]
-    mass = float(T[:, 0] @ (model.M @ T[:, 0]))
-    x = model.points
-    # first moments: Σ_ab M_ab x_b over the x-component rows
-    Mx = model.M[0::3, 0::3]
-    ones = np.ones(len(x))
-    first = np.array([ones @ (Mx @ x[:, k]) for k in range(3)])
-    c = first / mass
+    mass, c = mass_and_centre(model)
     Rc = rigid_body_modes(model.points, c)[:, 3:]
     inertia = Rc.T @ (model.M @ Rc)
     return {"mass": mass, "centre": c, "inertia": inertia}

@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import NumericalError, SceneError
-from .assembly import FEModel, rigid_body_modes
+from .assembly import FEModel, mass_and_centre, rigid_body_modes
 from .memory import PeakMemory
 from .supports import Support, reduce_matrix, reduction
 
@@ -271,11 +271,7 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             raise NumericalError("modal: negative eigenvalue among the elastic modes; "
                                  "check for inverted elements")
         shapes = T @ X
-        mtot = float(np.ones(len(model.points)) @ (model.M[0::3, 0::3] @
-                                                   np.ones(len(model.points))))
-        Mx = model.M[0::3, 0::3]
-        c = np.array([np.ones(len(model.points)) @ (Mx @ model.points[:, i])
-                      for i in range(3)]) / mtot
+        mtot, c = mass_and_centre(model)
         R = rigid_body_modes(model.points, c)
         gamma = shapes[:, n_rigid:].T @ (model.M @ R)
         timings["checks_s"] = time.perf_counter() - t0

@@ -8,11 +8,9 @@ and orthogonality checks, timings per phase, peak memory; mode shapes to ``modes
 
 from __future__ import annotations
 
-import time
-
 from ..schema import Field
 from ..schema import validate as validate_table
-from .stage_common import BACKEND_FIELD, fe_model, part_and_material
+from .stage_common import BACKEND_FIELD, part_and_material, timed_fe_model
 
 SECTION = "modal"
 REQUIRES = ("geometry", "material")
@@ -45,7 +43,6 @@ def validate(raw: dict, scene) -> dict:
 
 
 def run(p: dict, ctx) -> dict:
-    from .assembly import mass_properties
     from .classify import classify
     from .memory import PeakMemory
     from .modal import solve_modes
@@ -54,16 +51,13 @@ def run(p: dict, ctx) -> dict:
 
     part, mat = part_and_material(ctx, SECTION)
     with PeakMemory() as mem:
-        t0 = time.perf_counter()
-        model = fe_model(ctx, part, mat)
-        t_asm = time.perf_counter() - t0
+        model, t_asm = timed_fe_model(ctx, part, mat)
         sup = select(part, p["supports"], SECTION)
         modes = solve_modes(model, p["n_modes"], sup, backend=p["backend"],
                             band=p["band"], tol=p["tol"])
         classes = classify(model.points[model.used], modes.shapes.reshape(-1, 3, modes.shapes.shape[1])
                            [model.used].reshape(-1, modes.shapes.shape[1]), axis=p["axis"])
     ctx.products[SECTION] = modes
-    mp = mass_properties(model)
     res = modes.to_dict()
     res.update({
         "n_elements": model.n_elements,
@@ -71,14 +65,14 @@ def run(p: dict, ctx) -> dict:
         "classes": [c["label"] for c in classes],
         "class_fractions": [{k: float(v) for k, v in c.items() if k != "label"} for c in classes],
         "supports": [{"label": s.label, "fix": s.fix, "n_nodes": len(s.nodes)} for s in sup],
-        "mass_kg": mp["mass"],
+        "mass_kg": modes.total_mass,
         "timings_s": {**model.timings, "assembly_total_s": t_asm, **modes.timings},
         "peak_memory_bytes": mem.peak,
         "warnings": list(model.warnings),
     })
     if part.cad_mass is not None:
         cad = part.cad_mass.mass(mat.rho)
-        res["mass_vs_cad"] = mp["mass"] / cad - 1.0
+        res["mass_vs_cad"] = modes.total_mass / cad - 1.0
     if p["vtu"]:
         res["vtu"] = str(write_modes(ctx.out_dir / "modes.vtu", part.mesh,
                                      modes.frequencies_hz, modes.shapes))

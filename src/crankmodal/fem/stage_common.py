@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 from ..errors import SceneError
 from ..schema import Field
 
@@ -34,3 +36,10 @@ def fe_model(ctx, part, mat):
         cache.clear()
         cache[key] = assemble(part, mat)
     return cache[key]
+
+
+def timed_fe_model(ctx, part, mat):
+    """:func:`fe_model` and the wall time it took, s (about 0 when an earlier stage assembled it)."""
+    t0 = time.perf_counter()
+    model = fe_model(ctx, part, mat)
+    return model, time.perf_counter() - t0

@@ -114,14 +114,11 @@ def run(p: dict, ctx) -> dict:
     out["material"] = mat.name
     out["warnings"] = list(model.warnings)
     if p["vtu"]:
-        import meshio
+        from .vtu import write_point_data
 
-        block = next(c for c in part.mesh.cells if c.type in ("tetra", "tetra10"))
         data = {"displacement": res.displacement, "von_mises": res.von_mises,
                 "principal": res.principal}
-        path = ctx.out_dir / "static.vtu"
-        meshio.write(path, meshio.Mesh(model.points, [(block.type, block.data)], point_data=data))
-        out["vtu"] = str(path)
+        out["vtu"] = str(write_point_data(ctx.out_dir / "static.vtu", part.mesh, data))
     sfu = res.safety_factor_ultimate
     out["summary"] = (f"max von Mises {res.max_von_mises / 1e6:.4g} MPa at "
                       f"{np.array2string(res.max_location, precision=4)} m, max displacement "

@@ -10,9 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..part import Cylinder, MassProperties, Part, Region
+from .loads import TET10_EDGES, facet_midnodes
 
-#: tetra10 edges in meshio's (VTK) node order, nodes 4..9.
-TET10_EDGES = np.array([[0, 1], [1, 2], [0, 2], [0, 3], [1, 3], [2, 3]])
 _TET_FACES = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
 
 
@@ -36,15 +35,7 @@ def facet_nodes(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
     """All nodes (corners and, for tetra10, mid-edge nodes) of corner triangles."""
     nodes = [facets.ravel()]
     if cells.shape[1] == 10:
-        n = cells.max() + 1
-        e = np.sort(cells[:, TET10_EDGES], axis=2).reshape(-1, 2)
-        keys = e[:, 0].astype(np.int64) * n + e[:, 1]
-        mids = cells[:, 4:].ravel()
-        order = np.argsort(keys)
-        keys, mids = keys[order], mids[order]
-        fe = np.sort(facets[:, [[0, 1], [1, 2], [0, 2]]], axis=2).reshape(-1, 2)
-        fk = fe[:, 0].astype(np.int64) * n + fe[:, 1]
-        nodes.append(mids[np.searchsorted(keys, fk)])
+        nodes.append(facet_midnodes(facets, cells).ravel())
     return np.unique(np.concatenate(nodes))
 
 

@@ -29,9 +29,6 @@ def write_modes(path: str | Path, mesh, frequencies_hz, shapes: np.ndarray,
     extra_point_data : dict, optional
         Further point arrays (e.g. von Mises stress).
     """
-    import meshio
-
-    block = next(c for c in mesh.cells if c.type in ("tetra", "tetra10"))
     n = len(mesh.points)
     data = {}
     for name, col in zip(mode_array_names(frequencies_hz), np.asarray(shapes).T):
@@ -39,7 +36,15 @@ def write_modes(path: str | Path, mesh, frequencies_hz, shapes: np.ndarray,
         peak = np.linalg.norm(u, axis=1).max()
         data[name] = u / peak if peak > 0 else u
     data.update(extra_point_data or {})
+    return write_point_data(path, mesh, data)
+
+
+def write_point_data(path: str | Path, mesh, point_data: dict) -> Path:
+    """Write the volume mesh (its tetra/tetra10 block) with the given point arrays."""
+    import meshio
+
+    block = next(c for c in mesh.cells if c.type in ("tetra", "tetra10"))
     path = Path(path)
     meshio.write(path, meshio.Mesh(np.asarray(mesh.points, float), [(block.type, block.data)],
-                                   point_data=data), binary=True)
+                                   point_data=point_data), binary=True)
     return path

@@ -24,16 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import GeometryError, SceneError
+from ..errors import SceneError
+from ..fem.loads import facet_midnodes, facet_quadrature
 
 KINDS = ("rigid", "distributing")
-
-#: Degree-4 six-point rule on the unit triangle (Dunavant): barycentric (L2, L3) and weights
-#: summing to 1 (multiply by the reference area 1/2).
-_A, _B = 0.445948490915965, 0.091576213509771
-_TRI_QP = np.array([[_A, _A], [1 - 2 * _A, _A], [_A, 1 - 2 * _A],
-                    [_B, _B], [1 - 2 * _B, _B], [_B, 1 - 2 * _B]])
-_TRI_W = np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)
 
 
 @dataclass
@@ -77,46 +71,6 @@ class Interface:
                 "n_nodes": len(self.nodes)}
 
 
-def facet_midnodes(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """Mid-side nodes of corner triangles of a ``tetra10`` mesh, shape (n_facets, 3).
-
-    Column k is the node on edge (k, k+1 mod 3) of each triangle. Raises GeometryError if an
-    edge is not an element edge.
-    """
-    edges = np.array([[0, 1], [1, 2], [0, 2], [0, 3], [1, 3], [2, 3]])  # meshio tetra10 order
-    n = int(cells.max()) + 1
-    e = np.sort(cells[:, edges], axis=2).reshape(-1, 2)
-    keys = e[:, 0].astype(np.int64) * n + e[:, 1]
-    mids = cells[:, 4:].ravel()
-    order = np.argsort(keys, kind="stable")
-    keys, mids = keys[order], mids[order]
-    fe = np.sort(facets[:, [[0, 1], [1, 2], [2, 0]]], axis=2).reshape(-1, 2)
-    fk = fe[:, 0].astype(np.int64) * n + fe[:, 1]
-    pos = np.minimum(np.searchsorted(keys, fk), len(keys) - 1)
-    if not np.array_equal(keys[pos], fk):
-        raise GeometryError("region facets are not faces of the mesh's tetra10 elements")
-    return mids[pos].reshape(-1, 3)
-
-
-def _tri_shapes(order: int):
-    """Shape functions (n_qp, n_loc) and their (L2, L3) derivatives (n_qp, n_loc, 2)."""
-    L2, L3 = _TRI_QP[:, 0], _TRI_QP[:, 1]
-    L1 = 1 - L2 - L3
-    if order == 1:
-        N = np.column_stack([L1, L2, L3])
-        dN = np.broadcast_to(np.array([[-1, -1], [1, 0], [0, 1]], float), (len(L1), 3, 2)).copy()
-        return N, dN
-    L = np.column_stack([L1, L2, L3])
-    dL = np.array([[-1, -1], [1, 0], [0, 1]], float)  # dL_i / d(L2, L3)
-    N = np.column_stack([L * (2 * L - 1), 4 * L1 * L2, 4 * L2 * L3, 4 * L3 * L1])
-    dN = np.zeros((len(L1), 6, 2))
-    for i in range(3):
-        dN[:, i] = (4 * L[:, i] - 1)[:, None] * dL[i]
-    for k, (i, j) in enumerate(((0, 1), (1, 2), (2, 0))):
-        dN[:, 3 + k] = 4 * (L[:, i, None] * dL[j] + L[:, j, None] * dL[i])
-    return N, dN
-
-
 def surface_mass(points: np.ndarray, facets: np.ndarray, cells: np.ndarray):
     """Scalar surface mass matrix ``∫_Γ N_a N_b dA`` of a region (isoparametric triangles).
 
@@ -135,12 +89,8 @@ def surface_mass(points: np.ndarray, facets: np.ndarray, cells: np.ndarray):
     Ms : scipy.sparse.csr_matrix, shape (len(nodes), len(nodes))
         m².
     """
-    order = 2 if cells.shape[1] == 10 else 1
-    tri = facets if order == 1 else np.hstack([facets, facet_midnodes(facets, cells)])
-    N, dN = _tri_shapes(order)
-    x = points[tri]  # (f, a, 3)
-    jac = np.einsum("qak,fai->fqik", dN, x)  # (f, q, 3, 2)
-    dA = np.linalg.norm(np.cross(jac[..., 0], jac[..., 1]), axis=2) * (0.5 * _TRI_W)  # (f, q)
+    tri, N, nda = facet_quadrature(points, cells, facets)
+    dA = np.linalg.norm(nda, axis=2)  # (f, q): area element times quadrature weight
     me = np.einsum("qa,qb,fq->fab", N, N, dA)
     nodes, local = np.unique(tri, return_inverse=True)
     local = local.reshape(tri.shape)

@@ -100,16 +100,14 @@ def run(p: dict, ctx) -> dict:
     import numpy as np
 
     from ..fem.memory import PeakMemory
-    from ..fem.stage_common import fe_model, part_and_material
+    from ..fem.stage_common import part_and_material, timed_fe_model
     from .interfaces import make_interfaces
     from .io import save_flexbody
     from .reduce import reduce_body
 
     part, mat = part_and_material(ctx, SECTION)
     with PeakMemory() as mem:
-        t0 = time.perf_counter()
-        model = fe_model(ctx, part, mat)
-        t_asm = time.perf_counter() - t0
+        model, t_asm = timed_fe_model(ctx, part, mat)
         itf = make_interfaces(part, interface_specs(part, p))
         body, cb = reduce_body(model, itf, n_modes=p["n_modes"], cutoff_hz=p["cutoff_hz"],
                                backend=p["backend"],
