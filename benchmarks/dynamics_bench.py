@@ -62,6 +62,16 @@ def four_star_params(overrides=()):
     return params["dynamics"], params["mechanism"]
 
 
+def run_scene(scene, overrides):
+    """Check a scene of ``scenes/`` with overrides, build its mechanism, simulate (720 per rev)."""
+    params = check(load_scene(ROOT / "scenes" / scene, list(overrides)))
+    p = params["dynamics"]
+    mech = build_mechanism(p, params.get("mechanism"))
+    h = simulate(mech, p["end_time"], 1.0 / (720 * mech.revolution_hz),
+                 solver_settings(p, mech.revolution_hz * 60))
+    return mech, h
+
+
 def bench_four_star(t_end=1.0):
     p, mp = four_star_params([f"dynamics.end_time={t_end}"])
     mech = build_mechanism(p, mp)
@@ -88,11 +98,7 @@ def trends(out: Path, t_end=0.3):
     base = [f"dynamics.end_time={t_end}", "dynamics.ramp_time=0.0"]
 
     def run(extra):
-        p, mp = four_star_params(base + list(extra))
-        mech = build_mechanism(p, mp)
-        h = simulate(mech, p["end_time"], 1.0 / (720 * mech.revolution_hz),
-                     solver_settings(p, mech.revolution_hz * 60))
-        return mech, h
+        return run_scene("four_star_dynamics.toml", base + list(extra))
 
     # Fig. 24: clearance 0.10 / 0.15 / 0.20 mm at 1480 rpm
     fig, ax = plt.subplots(2, 3, figsize=(14, 7))
@@ -166,13 +172,7 @@ def wear_trend(out: Path, t_end=0.08):
         clear = (f"dynamics.clearances=[{{joint='big_end_1', clearance=5e-5, "
                  f"clearance_major={major}, journal_radius=0.024}}, {{joint='small_end_1', "
                  "clearance=2.5e-5, journal_radius=0.013}]")
-        scene = load_scene(ROOT / "scenes" / "slider_crank_dynamics.toml",
-                           [clear, f"dynamics.end_time={t_end}"])
-        params = check(scene)
-        p, mp = params["dynamics"], params["mechanism"]
-        mech = build_mechanism(p, mp)
-        h = simulate(mech, t_end, 1.0 / (720 * mech.revolution_hz),
-                     solver_settings(p, mech.revolution_hz * 60))
+        _, h = run_scene("slider_crank_dynamics.toml", [clear, f"dynamics.end_time={t_end}"])
         st = impact_statistics(h.onsets["big_end_1"])
         rows.append((major, st["impact_count"], st["impact_velocity_max"],
                      st["impact_velocity_rms"], h.energy_error()))

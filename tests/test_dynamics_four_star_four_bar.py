@@ -51,9 +51,11 @@ def test_four_star_first_order_force_rotates_with_constant_magnitude(star_ideal)
 
 def test_four_star_row_offsets_make_a_moment_about_the_crank_centre(star_ideal):
     m, h = star_ideal
-    # the moment is z * (big-end force) summed over rows; recompute it from the joint forces
-    M = sum(z * np.column_stack([h.joint_forces[f"big_end_{i}"][:, 1],
-                                 -h.joint_forces[f"big_end_{i}"][:, 0]])
+    # joint_forces[big_end_i] is the force of the crank on rod i; the crank takes its reaction
+    # at (0, 0, z_i): M = sum_i (0, 0, z_i) x (-f_i), in-plane components (cross product taken
+    # with numpy, not the hand-expanded formula of history.record)
+    M = sum(np.cross([0.0, 0.0, z], -np.column_stack([h.joint_forces[f"big_end_{i}"],
+                                                      np.zeros(h.t.size)]))[:, :2]
             for i, z in enumerate((0.02, 0.02, -0.02, -0.02), start=1))
     np.testing.assert_allclose(h.main_bearing_moment, M, atol=1e-9)
     assert np.abs(h.main_bearing_moment).max() > 1.0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -88,9 +89,7 @@ def tolerance_study(mech, t_end, output_step, rtols, t_start=0.0, base=None) -> 
     base = base or SolverSettings()
     rows = []
     for rtol in sorted(rtols, reverse=True):
-        s = SolverSettings(method=base.method, rtol=rtol, atol=base.atol * rtol / base.rtol,
-                           velocity_scale=base.velocity_scale, max_step=base.max_step,
-                           max_rhs_evals=base.max_rhs_evals)
+        s = replace(base, rtol=rtol, atol=base.atol * rtol / base.rtol)
         t0 = time.perf_counter()
         h = simulate(mech, t_end, output_step, s, energy_tolerance=None)
         wall = time.perf_counter() - t0

@@ -4,7 +4,8 @@ Conventions (all laws): ``delta`` is the penetration depth in m (> 0 in contact)
 its rate in m/s (> 0 while the bodies approach), ``v_impact`` the penetration rate at the onset
 of the current contact in m/s (> 0). A law returns the normal force in N, compressive positive;
 outside contact (``delta <= 0``) it returns 0. No law returns a tensile (adhesive) force: the
-force is clipped at zero, the clipped part is booked as dissipation by :func:`split_power`.
+force is clipped at zero; the clearance joint books ``(F - F_elastic) delta_dot`` (with
+:func:`elastic_force`) as dissipated power, so the clipped part counts as dissipation.
 
 Stiffness ``K`` is in N/m**n for an exponent ``n`` (n = 1 linear, n = 1.5 Hertz, n ~ 1.1 for
 cylinder-in-cylinder contact).
@@ -151,11 +152,6 @@ def elastic_energy(law, delta, params):
     """Potential of :func:`elastic_force`, J: ``K delta**(n+1) / (n+1)``."""
     n = 1.0 if law == "kelvin_voigt" else params.get("exponent", 1.5)
     return params["stiffness"] * _pos(delta) ** (n + 1.0) / (n + 1.0)
-
-
-def split_power(force, elastic, delta_dot):
-    """Power dissipated by a normal force, W: ``(F - F_elastic) * delta_dot`` (>= 0 for sane laws)."""
-    return (np.asarray(force) - np.asarray(elastic)) * np.asarray(delta_dot)
 
 
 def coulomb_coefficient(v, mu_s, mu_d, v_s, v_d):

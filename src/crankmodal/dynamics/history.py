@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .joints import AngleDrive, Revolute
-from .system import N_AUX
+from .system import AUX_NAMES, N_AUX
 
 
 @dataclass
@@ -100,6 +100,7 @@ def record(mech, sysm, integ) -> History:
     angle = integ.y[crank_sl.start + 2]
     speed = integ.y[n + crank_sl.start + 2]
     pins = [(c, r) for c, r in zip(sysm.constraints, sysm.rows) if isinstance(c, Revolute)]
+    drives = [r for c, r in zip(sysm.constraints, sysm.rows) if isinstance(c, AngleDrive)]
     forces = {c.name: np.zeros((K, 2)) for c, _ in pins}
     for cj in sysm.clearances:
         forces[cj.name] = np.zeros((K, 2))
@@ -112,8 +113,8 @@ def record(mech, sysm, integ) -> History:
     alpha = {b.name: np.zeros(K) for b in sysm.bodies if b.ndof == 3}
     for k in range(K):
         q, qd = integ.y[:n, k], integ.y[n:2 * n, k]
-        for cj in sysm.clearances:  # impact velocity of the contact in progress
-            cj.v_impact = _impact_velocity(integ.onsets[sysm.clearances.index(cj)], integ.t[k], cj)
+        for cj, ons in zip(sysm.clearances, integ.onsets):  # the contact in progress
+            cj.v_impact = _impact_velocity(ons, integ.t[k], cj)
         out = sysm.solve(integ.t[k], q, qd)
         qdd, lam = out["qdd"], out["lam"]
         for i, sl in enumerate(piston_sl):
@@ -123,9 +124,8 @@ def record(mech, sysm, integ) -> History:
             acc[k, i] = u @ qdd[sl][:2]
         for c, r in pins:
             forces[c.name][k] = lam[r]
-        for c, r in zip(sysm.constraints, sysm.rows):
-            if isinstance(c, AngleDrive):
-                torque[k] = -lam[r][0]
+        for r in drives:
+            torque[k] = -lam[r][0]
         for cj, ck in zip(sysm.clearances, out["contacts"]):
             forces[cj.name][k] = -ck["force"]
             d = contact[cj.name]
@@ -143,13 +143,12 @@ def record(mech, sysm, integ) -> History:
         for b in sysm.bodies:
             if b.name in alpha:
                 alpha[b.name][k] = qdd[sysm.slices[id(b)].start + 2]
-    if not any(isinstance(c, AngleDrive) for c in sysm.constraints):
+    if not drives:
         for ld in sysm.loads:
             if hasattr(ld, "torque"):
                 torque[:] = ld.torque
     aux = integ.y[2 * n: 2 * n + N_AUX]
-    for name, row in zip(("work_drive", "work_loads", "work_constraints", "dissipated_contact",
-                          "dissipated_friction"), aux):
+    for name, row in zip(AUX_NAMES, aux):
         energy[name] = row.copy()
     e_mech = energy["kinetic"] + energy["potential"] + energy["contact_elastic"]
     energy["residual"] = (e_mech - e_mech[0]) - (energy["work_drive"] + energy["work_loads"]

@@ -59,13 +59,6 @@ class Mechanism:
     main_joint: str = "main"
     rows_z: dict = field(default_factory=dict)
 
-    def constraint_index(self, name, ideal=False):
-        sysm = self.ideal if ideal else self.system
-        for c, r in zip(sysm.constraints, sysm.rows):
-            if c.name == name:
-                return r
-        raise KeyError(name)
-
 
 def _unit(angle):
     return np.array([np.cos(angle), np.sin(angle)])

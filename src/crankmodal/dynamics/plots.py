@@ -16,6 +16,14 @@ def _plt():
     return plt
 
 
+def _save(plt, fig, path: Path) -> Path:
+    """Lay out, write (PNG, 110 dpi) and close a figure."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def plot_piston(hist, ideal, path: Path, piston: int = 0) -> Path:
     """Piston acceleration against time and the acceleration-velocity phase diagram."""
     plt = _plt()
@@ -30,10 +38,7 @@ def plot_piston(hist, ideal, path: Path, piston: int = 0) -> Path:
     ax[1].set(xlabel="piston velocity [m/s]", ylabel="piston acceleration [m/s²]",
               title="phase diagram")
     ax[0].legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def plot_bearing_force(hist, spectrum, path: Path, ideal_spectrum=None) -> Path:
@@ -55,10 +60,7 @@ def plot_bearing_force(hist, spectrum, path: Path, ideal_spectrum=None) -> Path:
                                                   lambda o: o * _rev(spectrum)))
     sec.set_xlabel("engine order")
     ax[1].legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def _rev(spectrum):
@@ -78,10 +80,7 @@ def plot_orbit(hist, clearances, path: Path) -> Path:
         ax.plot(d["ex_bearing"] / c, d["ey_bearing"] / c, lw=0.6)
         ax.set(aspect="equal", xlabel="e_x / c (bearing frame)", ylabel="e_y / c",
                title=f"journal orbit, {name}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def plot_contact(hist, path: Path) -> Path:
@@ -97,10 +96,7 @@ def plot_contact(hist, path: Path) -> Path:
     ax[0].set(ylabel="normal force [N]")
     ax[1].set(xlabel="t [s]", ylabel="penetration [µm]")
     ax[0].legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def plot_drive(hist, ideal, path: Path) -> Path:
@@ -115,10 +111,7 @@ def plot_drive(hist, ideal, path: Path) -> Path:
     ax[0].set(ylabel="drive torque [N m]")
     ax[1].set(xlabel="t [s]", ylabel="drive power [W]")
     ax[0].legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def plot_energy(hist, path: Path) -> Path:
@@ -129,10 +122,7 @@ def plot_energy(hist, path: Path) -> Path:
         ax.plot(hist.t, v, lw=1.2 if k == "residual" else 0.8, label=k)
     ax.set(xlabel="t [s]", ylabel="energy [J]")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def plot_study(study, path: Path) -> Path:
@@ -147,7 +137,4 @@ def plot_study(study, path: Path) -> Path:
         ax.annotate(f"rtol {r:g}", (x, max(y, 1e-12)), fontsize=7)
     ax.set(xlabel="wall time [s]", ylabel="relative change vs tightest rtol")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)

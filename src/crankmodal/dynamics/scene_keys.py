@@ -9,6 +9,7 @@ import numpy as np
 from ..errors import SceneError
 from ..schema import Field, validate
 from . import contact
+from .clearance import FILM_MODELS
 
 MECHANISMS = ("slider_crank", "four_star", "four_bar")
 METHODS = ("auto", "LSODA", "Radau", "BDF", "RK45", "DOP853")
@@ -98,7 +99,7 @@ CLEARANCE = {
                        "(Ocvirk) film force", gt=0.0),
     "bearing_length": Field("float", None, "bearing length for the film force, m", gt=0.0),
     "film_model": Field("str", "short", "film force with viscosity: short (Ocvirk) or finite "
-                        "(Reynolds, tabulated per L/D)", choices=("short", "finite")),
+                        "(Reynolds, tabulated per L/D)", choices=FILM_MODELS),
 }
 
 CONTACT = {

@@ -22,11 +22,6 @@ class Spectrum:
     order: np.ndarray
     amplitude: np.ndarray
 
-    def at_orders(self, orders) -> np.ndarray:
-        """Amplitude at the bins nearest to the given engine orders."""
-        idx = [int(np.argmin(np.abs(self.order - k))) for k in orders]
-        return self.amplitude[idx]
-
 
 def amplitude_spectrum(t, x, revolution_hz, window="hann") -> Spectrum:
     """Windowed FFT of a uniformly sampled signal.

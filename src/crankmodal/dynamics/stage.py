@@ -113,6 +113,7 @@ def run(params: dict, ctx) -> dict:
             beta, rate = force_direction(ideal.t, ideal.joint_forces[cj.name])
             arrays[f"ideal_force_direction_{cj.name}"] = beta
             arrays[f"ideal_force_direction_rate_{cj.name}"] = rate
+    spec = None
     if n_rev >= 1:
         spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev_hz)
         arrays["spectrum_frequency_hz"] = spec.frequency_hz
@@ -122,7 +123,7 @@ def run(params: dict, ctx) -> dict:
     np.savez_compressed(out / "dynamics.npz", **arrays)
     res["arrays"] = "dynamics.npz"
     if ctx.figures:
-        res["figures"] = _figures(hist, ideal, mech, sel, study, out)
+        res["figures"] = _figures(hist, ideal, mech, sel, study, out, spec)
     k = key_outputs(hist, rev_hz, float(hist.t[sel][0]))
     n_imp = sum(j["impact_count"] for j in joints.values())
     if mech.pistons:
@@ -136,13 +137,15 @@ def run(params: dict, ctx) -> dict:
     return res
 
 
-def _figures(hist, ideal, mech, sel, study, out):
+def _figures(hist, ideal, mech, sel, study, out, spec=None):
+    """Write the PNG figures; ``spec``: the main-bearing spectrum if already computed."""
     from . import plots
     from .signals import amplitude_spectrum
 
     figs = []
     rev = mech.revolution_hz
-    spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev)
+    if spec is None:
+        spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev)
     ispec = None if ideal is None else amplitude_spectrum(ideal.t[sel],
                                                           ideal.main_bearing_force[sel], rev)
     figs.append(plots.plot_bearing_force(hist, spec, out / "dynamics_main_bearing.png", ispec))

@@ -77,9 +77,6 @@ class Multibody:
             self._drive_rows[r] = isinstance(c, AngleDrive)
 
     # ----------------------------------------------------------------- body access
-    def body_q(self, body, q):
-        return q[self.slices[id(body)]]
-
     def frame(self, body, frame, q, qd):
         """Pose, Jacobian (3, ndof_body) and ``Jdot qdot`` of an interface frame."""
         if isinstance(body, Ground):
