@@ -1,41 +1,12 @@
-"""Picking torsional modes out of FE mode shapes (synthetic fields on a cylinder)."""
+"""The first FE torsional mode beside the lumped-chain frequencies.
 
-import numpy as np
+Which FE modes are torsion is decided by the FE stage's classifier (``crankmodal.fem.classify``,
+tested against bar theory in ``tests/test_fem_misc.py``); here only the side-by-side table.
+"""
+
 import pytest
 
-from crankmodal.torsion.fe_compare import classify_modes, compare_with_fe, torsional_participation
-
-
-@pytest.fixture(scope="module")
-def cylinder():
-    # nodes filling a shaft of radius 0.05 m, length 1 m, along z, axis through (0.1, -0.2, 0)
-    rng = np.random.default_rng(3)
-    n = 4000
-    r = 0.05 * np.sqrt(rng.uniform(0, 1, n))
-    t = rng.uniform(0, 2 * np.pi, n)
-    z = rng.uniform(0, 1, n)
-    return np.column_stack([0.1 + r * np.cos(t), -0.2 + r * np.sin(t), z])
-
-
-def _twist(p, phi):
-    x, y = p[:, 0] - 0.1, p[:, 1] + 0.2
-    return np.column_stack([-y * phi, x * phi, np.zeros(len(p))])
-
-
-def test_twist_with_a_node_is_torsion(cylinder):
-    u = _twist(cylinder, np.cos(np.pi * cylinder[:, 2]))  # first free-free torsion mode of a shaft
-    assert torsional_participation(cylinder, u, (0.1, -0.2, 0.0), (0, 0, 1)) > 0.99
-
-
-def test_bending_and_axial_modes_are_not_torsion(cylinder):
-    z = cylinder[:, 2]
-    bend = np.column_stack([np.sin(np.pi * z), np.zeros_like(z), np.zeros_like(z)])
-    axial = np.column_stack([np.zeros_like(z), np.zeros_like(z), np.cos(np.pi * z)])
-    for u in (bend, axial):
-        assert torsional_participation(cylinder, u, (0.1, -0.2, 0.0), (0, 0, 1)) < 0.02
-    mixed = bend * 0.001 + _twist(cylinder, 1.0)  # small bending on a twist: still torsion
-    classes = classify_modes(cylinder, [bend, mixed, axial], (0.1, -0.2, 0.0), (0, 0, 1))
-    assert classes == ["other", "torsion", "other"]
+from crankmodal.torsion.fe_compare import compare_with_fe
 
 
 def test_compare_with_fe_picks_first_torsional_mode():

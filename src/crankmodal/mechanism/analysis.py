@@ -132,8 +132,7 @@ def analyse(m: Machine, n_per_rev: int = 720, max_order: int = 2, harmonics: str
     phi = np.array([c.bank_angle for c in cyl])
     gamma = np.array([c.throw_angle for c in cyl])
     b = np.array([c.axial_offset for c in cyl])
-    m_rec_rod, m_rot_rod = inr.rod_mass_split(m.rod.mass, m.rod.length, m.rod.cg_from_big_end)
-    m_s = np.array([c.piston_mass for c in cyl]) + m_rec_rod
+    m_s = np.array([c.piston_mass for c in cyl]) + m.rod.reciprocating_mass
     area = np.array([c.area for c in cyl])
 
     psi = theta[:, None] + gamma - phi
@@ -144,7 +143,7 @@ def analyse(m: Machine, n_per_rev: int = 720, max_order: int = 2, harmonics: str
     # --- inertia: forces on the frame -------------------------------------------------------
     recip = inr.reciprocating_force(m_s, mo.a, phi)  # (n, n_cyl, 2)
     crank_dir = theta[:, None] + gamma
-    rot_cyl = inr.rotating_force(m_rot_rod * r, w, crank_dir)  # (n, n_cyl, 2)
+    rot_cyl = inr.rotating_force(m.rod.rotating_mass * r, w, crank_dir)  # (n, n_cyl, 2)
     rot_crank = inr.rotating_force(m.crank_unbalance, w, theta)
     rotating = rot_cyl.sum(axis=1) + rot_crank
     shaking = recip.sum(axis=1) + rotating
@@ -206,16 +205,14 @@ def analyse(m: Machine, n_per_rev: int = 720, max_order: int = 2, harmonics: str
         shaking_moment=shaking_moment, counterweight_force=cw_force, friction_amplitude=f_amp,
         indicated_power_seed=ind_seed,
     )
-    res.scalars = _key_numbers(res, m_s, m_rec_rod, m_rot_rod, gas_work, cycles_per_s,
-                               (cw_mr, cw_angle, cw_residual))
+    res.scalars = _key_numbers(res, m_s, gas_work, cycles_per_s, (cw_mr, cw_angle, cw_residual))
     return res
 
 
-def _key_numbers(res: MechanismResults, m_s, m_rec_rod, m_rot_rod, gas_work, cycles_per_s, cw):
+def _key_numbers(res: MechanismResults, m_s, gas_work, cycles_per_s, cw):
     m = res.machine
     r, w = m.crank_radius, m.omega
     ref = float(np.mean(m_s)) * r * w**2  # one cylinder's first-order amplitude
-    f1max, f1min = inr.magnitude_range(res.order_force[0])
     orders = []
     for k in range(res.order_force.shape[0]):
         fmax, fmin = inr.magnitude_range(res.order_force[k])
@@ -223,6 +220,7 @@ def _key_numbers(res: MechanismResults, m_s, m_rec_rod, m_rot_rod, gas_work, cyc
         orders.append({"order": k + 1, "coefficient": float(res.order_coefficients[k]),
                        "force_max_n": fmax, "force_min_n": fmin,
                        "moment_max_nm": mmax, "moment_min_nm": mmin})
+    f1max, f1min = orders[0]["force_max_n"], orders[0]["force_min_n"]
     second = orders[1]["force_max_n"] if len(orders) > 1 else None
     sh_max, sh_min = inr.magnitude_range(res.shaking_force)
     bal = res.shaking_force + res.counterweight_force
@@ -239,8 +237,8 @@ def _key_numbers(res: MechanismResults, m_s, m_rec_rod, m_rot_rod, gas_work, cyc
         "n_cylinders": len(m.cylinders),
         "cycle_revolutions": m.cycle_revolutions,
         "reciprocating_mass_kg": m_s,
-        "rod_reciprocating_mass_kg": m_rec_rod,
-        "rod_rotating_mass_kg": m_rot_rod,
+        "rod_reciprocating_mass_kg": m.rod.reciprocating_mass,
+        "rod_rotating_mass_kg": m.rod.rotating_mass,
         "rod_inertia_defect_kg_m2": m.rod.inertia_defect,
         "peak_acceleration_m_s2": res.a.max(axis=0),
         "min_acceleration_m_s2": res.a.min(axis=0),

@@ -22,22 +22,6 @@ def normal(angle):
     return np.stack([np.cos(angle), -np.sin(angle)], axis=-1)
 
 
-def rod_mass_split_seed(piston_mass: float, rod_mass: float, rod_share: float = 0.35):
-    """Seed 000's rule of thumb: ``m_s = m_p + (0.3..0.4) m_d``, ``m_r = (0.6..0.7) m_d`` (kg)."""
-    return piston_mass + rod_share * rod_mass, (1.0 - rod_share) * rod_mass
-
-
-def rod_mass_split(rod_mass: float, rod_length: float, cg_from_big_end: float):
-    """Exact two-mass split of a rod: same mass and centre of mass (kg, kg).
-
-    Returns ``(m_small_end, m_big_end) = (m L1/l, m (l - L1)/l)``. The inertia force of the two
-    point masses equals the rod's exactly; only the inertia couple needs the correction
-    ``J - m L1 (l - L1)`` (see :func:`rod_couple_torque` in ``forces``).
-    """
-    m_small = rod_mass * cg_from_big_end / rod_length
-    return m_small, rod_mass - m_small
-
-
 def reciprocating_force(mass, acceleration, bank_angle):
     """Inertia force of a reciprocating mass on the frame (N), vector ``m a e``.
 

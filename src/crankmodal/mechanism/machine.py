@@ -33,7 +33,12 @@ class Rod:
 
     @property
     def reciprocating_mass(self) -> float:
-        """Exact two-mass split: share at the small end, ``m L1 / l`` (kg)."""
+        """Exact two-mass split: share at the small end, ``m L1 / l`` (kg).
+
+        The two point masses keep the rod's mass and centre of mass, so their inertia force is
+        the rod's exactly; only the inertia couple needs :attr:`inertia_defect` (seed 000's rule
+        of thumb ``(0.3..0.4) m_d`` is this with ``L1 = (0.3..0.4) l``).
+        """
         return self.mass * self.cg_from_big_end / self.length
 
     @property

@@ -96,11 +96,7 @@ def plot_shaking_polar(res, path):
     ax.set_xlabel("F$_x$ (kN)")
     ax.set_ylabel("F$_y$ (kN)")
     ax.set_title("shaking force on the frame over one cycle")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _finish(plt, fig, (ax,), path)
 
 
 def write_all(res, out_dir) -> list[str]:

@@ -13,7 +13,8 @@ Modules, one concept each:
   to two rotors;
 - :mod:`.holzer` -- the Holzer method (residual torque sweep, bracketed roots, Holzer table);
 - :mod:`.critical_speeds` -- orders x running speed against natural frequencies;
-- :mod:`.fe_compare` -- picking the torsional mode out of FE results and the side-by-side table;
+- :mod:`.fe_compare` -- the first FE torsional mode (as the FE classifier names it) beside the
+  lumped-chain frequencies;
 - :mod:`.plots` -- PNG figures (matplotlib imported inside the functions);
 - :mod:`.stage` -- the ``[torsion]`` scene section.
 

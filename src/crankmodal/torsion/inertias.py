@@ -112,8 +112,8 @@ def inertia_about_axis(
     """
     n = np.asarray(axis_direction, float)
     n = n / np.linalg.norm(n)
-    ic = np.asarray(mass_properties.inertia_per_density, float) * density
-    mass = mass_properties.volume * density
+    ic = mass_properties.inertia(density)
+    mass = mass_properties.mass(density)
     r = np.asarray(mass_properties.centroid, float) - np.asarray(axis_point, float)
     r_perp = r - (r @ n) * n
     return float(n @ ic @ n + mass * (r_perp @ r_perp))

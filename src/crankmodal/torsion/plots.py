@@ -16,6 +16,14 @@ def _pyplot():
     return plt
 
 
+def _save(plt, fig, path) -> Path:
+    """Write the PNG and free the figure."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
 def plot_holzer_residual(result, path: str | Path) -> Path:
     """Holzer residual over the frequency sweep, roots marked.
 
@@ -36,10 +44,7 @@ def plot_holzer_residual(result, path: str | Path) -> Path:
     ax.set_xlabel("trial frequency (Hz)")
     ax.set_ylabel(f"asinh(residual / {s:.3g} {unit})")
     ax.set_title("Holzer residual")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return _save(plt, fig, path)
 
 
 def plot_mode_shapes(chain, modes, path: str | Path, max_modes: int = 6) -> Path:
@@ -60,10 +65,7 @@ def plot_mode_shapes(chain, modes, path: str | Path, max_modes: int = 6) -> Path
     ax.set_ylabel("twist (normalised)")
     ax.set_title("Torsional mode shapes (x: nodes)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return _save(plt, fig, path)
 
 
 def plot_campbell(crit, path: str | Path) -> Path:
@@ -90,7 +92,4 @@ def plot_campbell(crit, path: str | Path) -> Path:
     ax.set_ylabel("frequency (Hz)")
     ax.set_title("Interference diagram (red: critical speeds in range)")
     ax.legend(fontsize=8, loc="upper left")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    return _save(plt, fig, path)

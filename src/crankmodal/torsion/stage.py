@@ -21,6 +21,7 @@ from ..schema import Field
 from ..schema import validate as validate_table
 from .critical_speeds import ORDER_TYPES
 from .equivalent_length import THROW_FORMS
+from .inertias import SEED_RECIPROCATING_FACTOR
 
 SECTION = "torsion"
 REQUIRES = ()
@@ -69,7 +70,7 @@ THROW_SCHEMA: dict[str, Field] = {
     "web_below_axis": Field("float", doc="web outline extent from the shaft axis away from the pin, m", ge=0.0),
     "web_beyond_axis": Field("float", doc="web outline extent from the shaft axis towards and past the pin, m", gt=0.0),
     "reciprocating_mass": Field("float", doc="piston, crosshead, nuts, 1/3 of the rod, kg", ge=0.0),
-    "reciprocating_factor": Field("float", 0.508, "seed 004 eq. 2 factor", gt=0.0, le=1.0),
+    "reciprocating_factor": Field("float", SEED_RECIPROCATING_FACTOR, "seed 004 eq. 2 factor", gt=0.0, le=1.0),
     "big_end_mass": Field("float", doc="rotating 2/3 of the rod, kg", ge=0.0),
 }
 
@@ -233,14 +234,14 @@ def run(p: dict, ctx) -> dict:
     }
     if model is not None:
         res["crank_model"] = model.to_dict()
-    beside = beside_cad_and_fe(res, ctx)
+    beside = beside_cad_and_fe(res, ctx, p["n_throws"])
     if beside:
         res.update(beside)
     res["summary"] = _summary(res, crit)
     return res
 
 
-def beside_cad_and_fe(res: dict, ctx) -> dict:
+def beside_cad_and_fe(res: dict, ctx, n_throws: int = 1) -> dict:
     """The CAD polar inertia and the first FE torsional mode of the scene's own crank, if any.
 
     When the scene also has ``[geometry]`` (a crankshaft, axis z) and ``[material]``, the polar
@@ -262,8 +263,8 @@ def beside_cad_and_fe(res: dict, ctx) -> dict:
         model = res.get("crank_model")
         if model:
             t = model["throw_inertias_kgm2"]
-            n_throws = ctx.params.get("torsion", {}).get("n_throws") or 1
-            lumped = n_throws * (t["crankpin"] + t["webs"]) + model["flywheel_inertia_kgm2"]
+            throws = n_throws * (t["crankpin"] + t["webs"])
+            lumped = throws + model["flywheel_inertia_kgm2"]
             cad["lumped_solid_inertia_kgm2"] = lumped
             cad["lumped_vs_cad"] = lumped / cad["cad_polar_inertia_kgm2"] - 1.0
             fw = part.regions.get("flywheel_face")
@@ -277,7 +278,7 @@ def beside_cad_and_fe(res: dict, ctx) -> dict:
                 cad["rotors"] = [
                     {"rotor": "throws (with journals and stubs)", "cut_z_m": z_cut,
                      "cad_kgm2": float(slabs[0]),
-                     "lumped_kgm2": n_throws * (t["crankpin"] + t["webs"])},
+                     "lumped_kgm2": throws},
                     {"rotor": "flywheel", "cut_z_m": z_cut, "cad_kgm2": float(slabs[1]),
                      "lumped_kgm2": model["flywheel_inertia_kgm2"]},
                 ]
