@@ -22,6 +22,23 @@ def _check_settings(settings: MeshSettings) -> None:
         raise GeometryError(f"geometry.refine: must be in (0, 1], got {settings.refine!r}")
 
 
+def mesh_tagged(gmsh, volumes: list, specs: list, settings: MeshSettings, refined=()):
+    """Name the regions of the current (synchronised) model, mesh it and read it back.
+
+    Returns
+    -------
+    mesh, regions, stats
+        The meshio mesh, the named :class:`~crankmodal.part.Region` objects and the mesh
+        statistics of :func:`~crankmodal.geometry.mesh.quality`.
+    """
+    tagged = tag_regions(gmsh, specs)
+    gmsh.model.addPhysicalGroup(3, volumes, name="solid")
+    set_sizes(gmsh, settings, list(refined))
+    generate(gmsh, settings)
+    mesh, index = to_meshio(gmsh)
+    return mesh, regions_from_mesh(gmsh, tagged, specs, index), quality(gmsh, mesh)
+
+
 def build_part(params: CrankshaftParams | ConrodParams, fidelity: str, settings: MeshSettings,
                name: str = "", step_file=None) -> Part:
     """Make, mesh and name a crankshaft or connecting rod.
@@ -63,14 +80,8 @@ def build_part(params: CrankshaftParams | ConrodParams, fidelity: str, settings:
             gmsh.option.setString("Geometry.OCCTargetUnit", "M")  # the STEP file says metres
             with quiet_stdout():  # OpenCASCADE's STEP writer prints its statistics
                 gmsh.write(str(step_file))
-        tagged = tag_regions(gmsh, specs)
-        gmsh.model.addPhysicalGroup(3, volumes, name="solid")
         refined = sorted(set(detail_faces(gmsh, detail["radius"])) | set(detail["faces"]))
-        set_sizes(gmsh, settings, refined)
-        generate(gmsh, settings)
-        mesh, index = to_meshio(gmsh)
-        regions = regions_from_mesh(gmsh, tagged, specs, index)
-        stats = quality(gmsh, mesh)
+        mesh, regions, stats = mesh_tagged(gmsh, volumes, specs, settings, refined)
     try:
         stats["mass_check"] = compare(cad, mesh_mass_properties(mesh.points, mesh.cells[0].data))
     except ValueError as exc:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 from ..errors import GeometryError
+from .conrod import bolt_offset
 from .params import FIDELITIES, ConrodParams, CrankshaftParams
 
 #: Relative clearance kept between neighbouring features (5 %).
@@ -185,8 +186,7 @@ def check_conrod(p: ConrodParams) -> ConrodParams:
     _at_most(c, "bolt_boss_height", p.bolt_boss_height, 2 * math.sqrt(max(rbo ** 2 - (MARGIN * rbi) ** 2, 0.0)),
              "the bosses must start outside the bore")
     if p.bolt_diameter > 0:
-        root = math.sqrt(rbo ** 2 - (p.bolt_boss_height / 2) ** 2)
-        off = p.bolt_offset if p.bolt_offset > 0 else 0.5 * (root + rbo + p.bolt_boss_width)
+        off = bolt_offset(p)  # the builder's own placement
         _at_least(c, "bolt_offset", off, MARGIN * (rbi + p.bolt_diameter / 2), "the bolt hole must miss the bore")
         _at_most(c, "bolt_offset", off, rbo + p.bolt_boss_width - MARGIN * p.bolt_diameter / 2,
                  "the bolt hole must stay inside the boss")

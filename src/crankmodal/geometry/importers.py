@@ -15,8 +15,9 @@ import numpy as np
 
 from ..errors import GeometryError, InputFileError
 from ..part import Cylinder, Part, Region
-from .mesh import MeshSettings, generate, quality, set_sizes, to_meshio
-from .regions import RegionSpec, regions_from_mesh, tag_regions
+from .massprops import _TET10_EDGES
+from .mesh import MeshSettings
+from .regions import RegionSpec
 
 CAD_SUFFIXES = (".step", ".stp", ".iges", ".igs", ".brep")
 
@@ -51,6 +52,7 @@ def region_specs(defs: list) -> list:
 
 def import_cad(path, specs: list, settings: MeshSettings) -> Part:
     """Mesh a STEP/IGES/BREP file (lengths converted to metres) and name its regions."""
+    from .build import mesh_tagged
     from .massprops import cad_mass_properties, compare, mesh_mass_properties
     from .session import gmsh_session, quiet_stdout
 
@@ -66,14 +68,11 @@ def import_cad(path, specs: list, settings: MeshSettings) -> Part:
         if not volumes:
             raise GeometryError(f"geometry.file: {path.name} holds no solid")
         cad = cad_mass_properties(gmsh, volumes)
-        tagged = tag_regions(gmsh, specs)
-        gmsh.model.addPhysicalGroup(3, volumes, name="solid")
-        set_sizes(gmsh, settings, [])
-        generate(gmsh, settings)
-        mesh, index = to_meshio(gmsh)
-        regions = regions_from_mesh(gmsh, tagged, specs, index)
-        stats = quality(gmsh, mesh)
-    stats["mass_check"] = compare(cad, mesh_mass_properties(mesh.points, mesh.cells[0].data))
+        mesh, regions, stats = mesh_tagged(gmsh, volumes, specs, settings)
+    try:
+        stats["mass_check"] = compare(cad, mesh_mass_properties(mesh.points, mesh.cells[0].data))
+    except ValueError as exc:  # as build_part: a folded element is a geometry failure
+        raise GeometryError(f"import {path.name}: {exc}") from None
     return Part(name=path.stem, mesh=mesh, regions=regions, fidelity="imported",
                 params={"file": str(path), "mesh": settings.to_dict()}, cad_mass=cad, quality=stats)
 
@@ -91,14 +90,12 @@ def _facet_nodes(cells: np.ndarray, facets: np.ndarray) -> np.ndarray:
     """All nodes (mid-side included) on the given corner facets of a tetra/tetra10 mesh."""
     nodes = set(np.unique(facets).tolist())
     if cells.shape[1] == 10:
-        # meshio tetra10 edges: (0,1),(1,2),(0,2),(0,3),(1,3),(2,3)
-        edges = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
         on = np.isin(cells[:, :4], facets)
-        for k, (i, j) in enumerate(edges):
+        fkeys = {tuple(sorted(e)) for f in facets.tolist() for e in ((f[0], f[1]), (f[1], f[2]), (f[0], f[2]))}
+        for k, (i, j) in enumerate(_TET10_EDGES):
             both = on[:, i] & on[:, j]
             if np.any(both):
                 ekey = np.sort(np.column_stack([cells[both, i], cells[both, j]]), axis=1)
-                fkeys = {tuple(sorted(e)) for f in facets for e in ((f[0], f[1]), (f[1], f[2]), (f[0], f[2]))}
                 mids = cells[both, 4 + k]
                 nodes.update(int(m) for (a, b), m in zip(ekey, mids) if (a, b) in fkeys)
     return np.array(sorted(nodes), dtype=np.int64)

@@ -202,7 +202,7 @@ def params_from_dict(part: str, table: dict, where: str = "") -> CrankshaftParam
             if not isinstance(value, str):
                 raise GeometryError(f"{prefix}.{name}: must be a string, got {value!r}")
             values[name] = value
-        elif isinstance(default, bool) or isinstance(default, int) and not isinstance(default, float):
+        elif isinstance(default, int):  # bool is an int too
             if isinstance(value, bool) or not isinstance(value, int):
                 raise GeometryError(f"{prefix}.{name}: must be an integer, got {value!r}")
             values[name] = value

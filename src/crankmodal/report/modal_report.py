@@ -149,14 +149,12 @@ MODE_HEADER = ["mode", "frequency, Hz", "class", "m_eff x, kg", "m_eff y, kg", "
 
 def measured_rows(frequencies_hz, measured_hz) -> list[list]:
     """Rows: mode, measured Hz, computed Hz, difference % (computed vs measured)."""
-    rows = []
-    for k, fm in enumerate(measured_hz):
-        if fm is None:
-            continue
-        fc = frequencies_hz[k] if k < len(frequencies_hz) else None
-        rows.append([k + 1, f"{fm:.1f}", None if fc is None else f"{fc:.1f}",
-                     None if fc is None else f"{100 * (fc - fm) / fm:+.2f} %"])
-    return rows
+    from .testing import compare_frequencies
+
+    return [[r["mode"], f"{r['expected_hz']:.1f}",
+             None if r["computed_hz"] is None else f"{r['computed_hz']:.1f}",
+             None if r["rel_error"] is None else f"{100 * r['rel_error']:+.2f} %"]
+            for r in compare_frequencies(frequencies_hz, measured_hz, rtol=1.0)]
 
 
 def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,

@@ -189,7 +189,6 @@ def run(p: dict, ctx) -> dict:
                        measured_hz=measured,
                        timings=timings, extra_images=images)
     if p["study"]:
-        from .study import cell
         from .study_scene import run_simplification
 
         st, paths = run_simplification(ctx.params, out_dir, figures=ctx.figures,
@@ -200,20 +199,7 @@ def run(p: dict, ctx) -> dict:
                       f"{st.compared_modes} modes, its cost the wall time to mesh and solve. "
                       f"Modes are paired with the reference model's by MAC on common surface "
                       f"points († marks a mode paired out of rank order).")
-        n = len(st.reference_hz)
-        rows = [[st.label(r) + (" (recommended)" if i == st.recommended else
-                                " (Pareto)" if i in st.pareto else ""),
-                 r["n_elements"], r["n_dofs"], f"{r['wall_time_s']:.3g}"]
-                + [cell(r, k) for k in range(n)]
-                + [f"{100 * r['error']:.2g} %"] for i, r in enumerate(st.runs)]
-        rows.insert(0, ["reference: " + st.reference_source[-1], None, None, None]
-                    + [f"{f:.0f}" for f in st.computed_reference_hz] + [None])
-        if measured:
-            cells = ["/" if f is None else f"{f:.0f}" for f in measured[:n]]
-            rows.insert(0, ["experiment", None, None, None] + cells + ["/"] * (n - len(cells))
-                        + [None])
-        rep.table(["model", "elements", "DOF", "time, s"] + [f"mode {k + 1}, Hz"
-                                                             for k in range(n)] + ["error"], rows)
+        rep.table(*st.table(measured))
         rep.paragraph(f"Recommendation (tolerance {100 * st.tolerance:.3g} %): "
                       f"{st.recommendation_text()}.")
         for key, cap in (("error_vs_time", "Error against run time, Pareto front dashed"),

@@ -30,8 +30,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-FIDELITIES = ("full", "dechamfered", "simplified")
-
 #: Smallest MAC accepted to pair a model's mode with a reference mode.
 MIN_PAIR_MAC = 0.6
 
@@ -170,26 +168,36 @@ class SimplificationStudy:
                 "pareto": self.pareto, "recommended": self.recommended,
                 "recommendation": self.recommendation_text()}
 
-    def table_markdown(self, measured_hz=None) -> str:
-        """Seed 000 Table 3 style: frequency per mode per model (% difference), element counts."""
+    def table(self, measured_hz=None, recommended: str = "(recommended)") -> tuple[list, list]:
+        """Seed 000 Table 3 style: frequency per mode per model (% difference), element counts.
+
+        Returns the header and the rows (None for an empty cell): the experiment (when
+        ``measured_hz`` is given), the computed reference, then one row per model, its label
+        followed by ``recommended`` or ``(Pareto)`` where it applies.
+        """
         n = len(self.reference_hz)
         head = ["model", "elements", "DOF", "time, s"] + [f"mode {k + 1}, Hz" for k in range(n)] \
             + ["error"]
-        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        rows = []
         if measured_hz:
             cells = [f"{f:.0f}" if f is not None else "/" for f in measured_hz[:n]]
-            cells += ["/"] * (n - len(cells))
-            lines.append("| experiment | | | | " + " | ".join(cells) + " | |")
+            rows.append(["experiment", None, None, None] + cells + ["/"] * (n - len(cells)) + [None])
         src = self.reference_source[-1] if self.reference_source else ""
-        lines.append(f"| reference: {src} | | | | "
-                     + " | ".join(f"{f:.0f}" for f in self.computed_reference_hz) + " | |")
+        rows.append([f"reference: {src}", None, None, None]
+                    + [f"{f:.0f}" for f in self.computed_reference_hz] + [None])
         for i, r in enumerate(self.runs):
-            mark = " **(recommended)**" if i == self.recommended else (
+            mark = f" {recommended}" if i == self.recommended else (
                 " (Pareto)" if i in self.pareto else "")
-            cells = [cell(r, k) for k in range(n)]
-            lines.append(f"| {self.label(r)}{mark} | {r['n_elements']} | {r['n_dofs']} | "
-                         f"{r['wall_time_s']:.3g} | " + " | ".join(cells)
-                         + f" | {100 * r['error']:.2g} % |")
+            rows.append([f"{self.label(r)}{mark}", r["n_elements"], r["n_dofs"],
+                         f"{r['wall_time_s']:.3g}"] + [cell(r, k) for k in range(n)]
+                        + [f"{100 * r['error']:.2g} %"])
+        return head, rows
+
+    def table_markdown(self, measured_hz=None) -> str:
+        """:meth:`table` as Markdown, the recommended model in bold."""
+        head, rows = self.table(measured_hz, recommended="**(recommended)**")
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        lines += ["|" + "|".join(" " if c is None else f" {c} " for c in row) + "|" for row in rows]
         return "\n".join(lines)
 
 
@@ -370,9 +378,11 @@ def write_study(study: SimplificationStudy, out_dir, measured_hz=None, title="",
         paths["error_vs_time"] = plots.plot_error_vs_time(study, out_dir / "error_vs_time.png")
         paths["convergence"] = plots.plot_convergence(study.runs, out_dir / "convergence.png",
                                                       reference_hz=study.computed_reference_hz)
+        k0 = reference_run(study.runs)
+        ref = study.runs[k0]
         for k, name in finest_per_fidelity(study.runs).items():
-            r, ref = study.runs[k], study.runs[reference_run(study.runs)]
-            if k == reference_run(study.runs) or "mac_to_reference" not in r:
+            r = study.runs[k]
+            if k == k0 or "mac_to_reference" not in r:
                 continue
             paths[f"mac_{name}"] = plots.plot_mac(
                 r["mac_to_reference"], out_dir / f"mac_{name}.png",

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SceneError
+from ..geometry.params import FIDELITIES
 
 
 def part_builder(geometry: dict):
@@ -54,7 +55,7 @@ def study_settings(report: dict, geometry: dict, modal: dict) -> dict:
     """Fidelities, sizes (m), orders and mode count of the study, defaults filled in."""
     h = geometry["mesh_size"]
     sizes = report.get("study_sizes") or [2.0 * h, np.sqrt(2.0) * h, h]
-    fids = list(report.get("study_fidelities") or ("full", "dechamfered", "simplified"))
+    fids = list(report.get("study_fidelities") or FIDELITIES)
     if geometry.get("file") is not None:
         fids = ["imported"]
     n = report.get("study_modes") or min(modal["n_modes"], 6)
