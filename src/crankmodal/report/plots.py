@@ -19,11 +19,9 @@ _COLOURS = {1: "tab:blue", 2: "tab:red"}
 
 
 def _figure(figsize=(7.0, 4.8)):
-    import matplotlib
+    from ..plotting import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=figsize, constrained_layout=True)
     return plt, fig, ax
 
