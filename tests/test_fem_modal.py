@@ -147,3 +147,46 @@ def test_radial_support_fits_the_cylinder_when_the_region_has_none():
     sup = supports.select(part, [{"region": "bore", "fix": "radial"}])
     np.testing.assert_allclose(abs(sup[0].cylinder.axis[2]), 1.0, atol=1e-9)
     assert sup[0].cylinder.radius == pytest.approx(0.02, rel=1e-3)
+
+
+def _merged(parts_points_cells):
+    """One Part from several (points, cells) P2 meshes; coincident points are merged."""
+    import meshio
+
+    from crankmodal.part import Part
+
+    pts = np.vstack([p for p, _ in parts_points_cells])
+    offs = np.cumsum([0] + [len(p) for p, _ in parts_points_cells[:-1]])
+    cells = np.vstack([c + o for (_, c), o in zip(parts_points_cells, offs)])
+    key = np.round(pts / 1e-9).astype(np.int64)
+    _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    order = np.sort(first)  # keep the points in their first-seen order
+    remap = np.searchsorted(order, first)[inv.ravel()]
+    return Part(name="merged", mesh=meshio.Mesh(pts[order], [("tetra10", remap[cells])]))
+
+
+def test_two_separate_bars_have_twelve_rigid_modes_and_each_elastic_mode_twice(free_modes):
+    part = bar(L, B, H, (40, 3, 3), order=2)
+    p, c = part.mesh.points, part.mesh.cells[0].data
+    two = _merged([(p, c), (p + [0.0, 0.3, 0.0], c)])
+    m = modal.solve_modes(assembly.assemble(two, STEEL), 8)
+    assert m.rigid_body_modes == 12
+    np.testing.assert_allclose(m.frequencies_hz[::2], free_modes.frequencies_hz[:4], rtol=1e-8)
+    np.testing.assert_allclose(m.frequencies_hz[1::2], free_modes.frequencies_hz[:4], rtol=1e-8)
+
+
+def test_bars_joined_at_one_corner_point_reveal_the_hinge_the_connectivity_hides():
+    """One shared node: the connectivity says one piece (6 rigid modes), the stiffness has 9."""
+    part = bar(0.3, B, H, (12, 2, 2), order=2)
+    p, c = part.mesh.points, part.mesh.cells[0].data
+    hinged = _merged([(p, c), (p + [0.3, B, H], c)])
+    with pytest.raises(NumericalError, match="found 9 zero-frequency modes"):
+        modal.solve_modes(assembly.assemble(hinged, STEEL), 4)
+
+
+def test_deflating_the_known_rigid_modes_changes_nothing_but_the_work(bar_model, free_modes):
+    plain = modal.solve_modes(bar_model[1], 8, expected_rigid=6)  # rigid modes found by ARPACK
+    np.testing.assert_allclose(free_modes.frequencies_hz, plain.frequencies_hz, rtol=1e-9)
+    assert free_modes.n_solves < plain.n_solves
+    mac = np.abs(np.sum(free_modes.shapes * (bar_model[1].M @ plain.shapes), axis=0))
+    assert np.all(mac > 1 - 1e-6)
