@@ -282,8 +282,7 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         # its own MKL threads per call
         with threadpool_limits(limits=1, user_api="blas"):
             lam, X = eigsh(K, k=k, M=M, sigma=sigma, which="LM", OPinv=op, v0=v0,
-                           tol=ARPACK_TOL, ncv=min(n - 1, 2 * k + 1 if deflate else
-                                                   max(2 * k + 1, k + 20)))
+                           tol=ARPACK_TOL, ncv=min(n - 1, max(2 * k + 1, k + 20)))
         if deflate:
             lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
         timings["eigsh_s"] = time.perf_counter() - t0

@@ -170,7 +170,9 @@ def _fixed_interface_modes(K, M, solver, k, G):
     """Lowest ``k`` eigenpairs of (K, M) on ker G: ARPACK shift-invert about 0 with ``solver``.
 
     (A block shift-invert Krylov with multi-RHS solves was tried: at 60 modes it needed ~280
-    vectors for residuals of 1e-5 and cost more CPU than ARPACK's ~1.5 ncv single solves.)
+    vectors for residuals of 1e-5 and cost more CPU than ARPACK's ~1.5 ncv single solves.
+    ARPACK's tolerance stays at 1e-12: at 1e-9 the single-vector Lanczos returned before it had
+    found both modes of a repeated pair of a tube, and the reduced model missed them.)
     """
     from scipy.sparse.linalg import LinearOperator, eigsh
     from threadpoolctl import threadpool_limits
