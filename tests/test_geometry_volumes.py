@@ -28,15 +28,19 @@ ROD = ConrodParams(
 
 
 def crank_volume_closed_form(p: CrankshaftParams, simplified: bool) -> float:
-    """Sum of cylinders, web slabs (stadium + counterweight sector), flywheel, minus keyway."""
+    """Sum of cylinders, web slabs (stadium + counterweight sector; simplified: their envelope
+    block), flywheel, minus keyway."""
     rj, rp, a, r = p.journal_diameter / 2, p.pin_diameter / 2, p.web_width / 2, p.throw_radius
     n = len(p.phases_deg)
     v = (n + 1) * math.pi * rj ** 2 * p.journal_length + n * math.pi * rp ** 2 * p.pin_length
     rs_f, rs_w = p.free_end_diameter / 2, p.flywheel_end_diameter / 2
     v += math.pi * rs_f ** 2 * p.free_end_length + math.pi * rs_w ** 2 * p.flywheel_end_length
-    web = 2 * a * r + math.pi * a ** 2                    # stadium: rectangle + two half discs
-    alpha = math.radians(p.counterweight_angle_deg) / 2
-    web += alpha * (p.counterweight_radius ** 2 - a ** 2)  # sector beyond the web's end disc
+    if simplified:  # the envelope block: web width by counterweight tip to pin end
+        web = 2 * a * (max(a, p.counterweight_radius) + (r + a if p.web_shape == "stadium" else a))
+    else:
+        web = 2 * a * r + math.pi * a ** 2                    # stadium: rectangle + two half discs
+        alpha = math.radians(p.counterweight_angle_deg) / 2
+        web += alpha * (p.counterweight_radius ** 2 - a ** 2)  # sector beyond the web's end disc
     v += 2 * n * p.web_thickness * web
     rf, t = p.flywheel_diameter / 2, p.flywheel_thickness
     rin, rh = rf - p.flywheel_rim_width, p.flywheel_hub_diameter / 2

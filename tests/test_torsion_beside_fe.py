@@ -9,7 +9,7 @@ from crankmodal.scene import scene_from_dict
 def test_seed004_lumped_inertias_agree_with_the_cad_solid_and_fe_torsion_is_reported(tmp_path):
     scene = scene_from_dict({
         "geometry": {"machine": "multi_bearing_compressor", "part": "crankshaft",
-                     "fidelity": "simplified", "mesh_size": 0.04, "element_order": 2},
+                     "fidelity": "dechamfered", "mesh_size": 0.03, "element_order": 2},
         "material": {"name": "SG 700/2"},
         "modal": {"n_modes": 6, "supports": [
             {"region": f"main_journal_{k}", "fix": "radial"} for k in (1, 2, 3)] + [

@@ -44,7 +44,10 @@ class CrankshaftParams:
         Crank webs, m. ``web_width`` is the width across the web (twice its end radius).
     web_shape : str
         ``stadium`` (round-ended bar from the journal to the pin axis, end radius web_width/2)
-        or ``round`` (disc about the shaft axis of diameter web_width).
+        or ``round`` (disc about the shaft axis of diameter web_width). At the ``simplified``
+        fidelity every web and its counterweight become their straight-sided envelope, a block
+        web_width wide from the counterweight tip to the web's pin end (heavier than the
+        contour: see :func:`~crankmodal.geometry.crankshaft.web_block`).
     counterweight_radius : float
         Outer radius of the counterweight sector opposite the pin, m (0: none).
     counterweight_angle_deg : float
