@@ -166,3 +166,25 @@ def test_worn_bore_contact_on_a_spinning_bearing_conserves_energy():
     el = float(contact.elastic_energy("hertz", joint.gap(sysm, y[:6]), joint.law_params))
     assert len(out.onsets[0]) >= 2
     assert ke + el == pytest.approx(ke0, rel=1e-6)
+
+
+def test_impact_statistics_counts_a_bouncing_ball_by_velocity_and_by_flight_time():
+    # closed form: a ball dropped onto a rigid floor at v0 with restitution e lands at
+    # v_k = e^k v0 after flights 2 v_{k-1} / g; the contact itself takes no time
+    from crankmodal.dynamics.signals import impact_statistics
+
+    g, v0, e = 9.81, 2.0, 0.8
+    v = v0 * e ** np.arange(30)
+    t_on = np.concatenate([[0.0], np.cumsum(2.0 * v[:-1] / g)])
+    onsets = list(zip(t_on, v))
+    seps = list(t_on)                                   # leaves the floor at once
+    all_ = impact_statistics(onsets, seps)
+    assert all_["impact_count"] == all_["onset_count"] == 30
+    assert all_["impact_velocity_max"] == pytest.approx(v0)
+    k_v = int(np.floor(np.log(0.3) / np.log(e))) + 1     # e^k >= 0.3
+    assert impact_statistics(onsets, seps, v_min=0.3 * v0)["impact_count"] == k_v
+    tau = 0.1                                            # flight 2 v0 e^(k-1) / g >= tau
+    k_f = 1 + int(np.floor(np.log(tau * g / (2 * v0)) / np.log(e))) + 1
+    st = impact_statistics(onsets, seps, min_flight=tau)
+    assert st["impact_count"] == k_f
+    assert st["impact_velocity_mean"] == pytest.approx(np.mean(v[:k_f]))

@@ -96,23 +96,42 @@ def test_finite_bearing_at_unit_length_ratio_reproduces_raimondi_boyd(eps, S, ph
     assert b.attitude_deg == pytest.approx(phi, abs=0.6)
 
 
-def test_finite_bearing_is_closer_than_the_short_bearing_to_seed_001_table_3_load():
-    # Seed 001 Table 3 (L/D = 1): dimensionless film force F psi^2 / (mu U L) and attitude
-    # angle for eps = 0.1 .. 0.7. The table's source and boundary conditions are not given;
-    # it lies 11..18 % below Raimondi-Boyd (and this solver) in load and 4..13 deg below in
-    # attitude angle, so the stated tolerance is 25 % of the table load and 13 deg, and the
-    # finite bearing must beat Ocvirk's short bearing in load (the short bearing
-    # overestimates the table by 63..164 %; its angles are 2..13 deg high).
-    eps = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])
-    load = np.array([0.197, 0.415, 0.680, 1.029, 1.524, 2.296, 3.654])
-    phi = np.array([75.11, 63.59, 55.55, 50.08, 45.32, 40.54, 36.02])
-    s = 1 - eps**2
-    short = eps * np.sqrt(16 * eps**2 + np.pi**2 * s) / s**2       # (L/D)^2 = 1
-    fin = [steady_bearing(e, 1.0) for e in eps]
-    fl = np.array([b.load for b in fin])
-    np.testing.assert_allclose(fl, load, rtol=0.25)
-    np.testing.assert_allclose([b.attitude_deg for b in fin], phi, atol=13.0)
-    assert np.all(np.abs(fl - load) < np.abs(short - load))
+# Seed 001 Table 3 ("bearing parameters of circular cylinder", L/2R = 1): dimensionless film
+# force X = F psi^2 / (mu U L) (its Eq. (2)) and attitude angle, eps = 0.1 .. 0.7. It is not the
+# full (360 deg) bearing: Raimondi-Boyd and this solver lie 11..18 % above it in load and
+# 4..13 deg above in attitude. A centrally loaded 150 deg partial bearing with Reynolds
+# cavitation (a common handbook arc; the seed does not name it) reproduces all 14 numbers: one
+# parameter, the arc, identified from the table, the rest is an independent solve.
+T3_EPS = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])
+T3_LOAD = np.array([0.197, 0.415, 0.680, 1.029, 1.524, 2.296, 3.654])
+T3_PHI = np.array([75.11, 63.59, 55.55, 50.08, 45.32, 40.54, 36.02])
+
+
+def test_seed_001_table_3_is_a_150_degree_partial_bearing_within_2p5_percent_and_1p5_deg():
+    # coarse 96 x 16 grid (3 s): the arc edges fall on nodes 3.75 deg apart, which moves the
+    # load by up to 2 % and the angle by 1.2 deg (192 x 32: 1.1 %, 0.6 deg, slow test below);
+    # the table's printed 3-4 digits are finer than that.
+    fin = [steady_bearing(e, 1.0, 96, 16, arc_deg=150.0) for e in T3_EPS]
+    np.testing.assert_allclose([b.load for b in fin], T3_LOAD, rtol=0.025)
+    np.testing.assert_allclose([b.attitude_deg for b in fin], T3_PHI, atol=1.5)
+    # the full bearing and the short bearing do not: 11..18 % and 38..164 % off in load
+    full = np.array([steady_bearing(e, 1.0, 96, 16).load for e in T3_EPS])
+    assert np.all(np.abs(full / T3_LOAD - 1.0) > 0.10)
+    s = 1 - T3_EPS**2
+    short = T3_EPS * np.sqrt(16 * T3_EPS**2 + np.pi**2 * s) / s**2       # (L/D)^2 = 1
+    assert np.all(np.abs(short / T3_LOAD - 1.0) > 0.3)
+
+
+@pytest.mark.slow
+def test_seed_001_table_3_arc_is_identified_within_5_deg_on_a_fine_grid():
+    def misfit(arc):
+        fin = [steady_bearing(e, 1.0, 192, 32, arc_deg=arc) for e in T3_EPS]
+        return (np.abs(np.array([b.load for b in fin]) / T3_LOAD - 1.0).max(),
+                np.abs(np.array([b.attitude_deg for b in fin]) - T3_PHI).max())
+    load_err, phi_err = misfit(150.0)
+    assert load_err < 0.015 and phi_err < 1.0
+    for arc in (145.0, 155.0):                  # 5 deg either side fits worse in load
+        assert misfit(arc)[0] > load_err
 
 
 STATES = [  # eps, eps_dot (1/s), gamma_dot (rad/s), omega (rad/s)

@@ -38,6 +38,8 @@ class History:
     energy : dict of (K,) arrays, J: kinetic, potential, contact_elastic, work_drive, work_loads,
         work_constraints, dissipated_contact, dissipated_friction, residual.
     constraint_drift : (K,) max |Phi|, m or rad.
+    onsets : dict joint -> [(t, v_impact)] contact onsets (s, m/s), every zero crossing.
+    separations : dict joint -> [t] contact separations, s.
     angular_acceleration : dict body name -> (K,) rad/s^2 (e.g. the loom's rocker and sley).
     """
 
@@ -56,6 +58,7 @@ class History:
     energy: dict
     constraint_drift: np.ndarray
     onsets: dict = field(default_factory=dict)
+    separations: dict = field(default_factory=dict)
     angular_acceleration: dict = field(default_factory=dict)
     nfev: int = 0
     wall_time: float = 0.0
@@ -168,7 +171,9 @@ def record(mech, sysm, integ) -> History:
                    main_bearing_force=main, main_bearing_moment=moment, drive_torque=torque,
                    drive_power=torque * speed, contact=contact, energy=energy,
                    constraint_drift=drift, angular_acceleration=alpha,
-                   onsets={cj.name: integ.onsets[i] for i, cj in enumerate(sysm.clearances)})
+                   onsets={cj.name: integ.onsets[i] for i, cj in enumerate(sysm.clearances)},
+                   separations={cj.name: integ.separations[i]
+                                for i, cj in enumerate(sysm.clearances)})
 
 
 def _impact_velocity(onsets, t, cj) -> float:

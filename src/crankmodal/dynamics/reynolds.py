@@ -99,7 +99,7 @@ def _solve_lcp(K, g, fixed, guess=None, max_iter=200):
 
 
 def solve_pressure(eps, l_over_d, rotation=1.0, squeeze=0.0, n_theta=144, n_zeta=24,
-                   cavitation="reynolds", inlet="max_film", guess=None):
+                   cavitation="reynolds", inlet="max_film", guess=None, arc=None):
     """Dimensionless film pressure for a rotation and a squeeze term together.
 
     Parameters
@@ -123,6 +123,9 @@ def solve_pressure(eps, l_over_d, rotation=1.0, squeeze=0.0, n_theta=144, n_zeta
         ``n_theta`` must be even for ``"max_film"``.
     guess : ndarray of bool (n_theta, n_zeta), optional
         First guess of the cavitated nodes (e.g. ``P[:, :-1] == 0`` of a nearby solution).
+    arc : (float, float), optional
+        Partial bearing: ``(centre, width)`` of the bearing arc in rad (``theta`` measured as
+        above); the film outside the arc is at ambient pressure. None: full (360 deg) bearing.
 
     Returns
     -------
@@ -146,13 +149,18 @@ def solve_pressure(eps, l_over_d, rotation=1.0, squeeze=0.0, n_theta=144, n_zeta
         raise ValueError(f"inlet must be one of {INLETS}; got {inlet!r}")
     if inlet == "max_film" and n_theta % 2:
         raise ValueError(f"n_theta must be even with inlet='max_film'; got {n_theta}")
+    fixed = np.zeros((n_theta, n_zeta), bool)
+    if arc is not None:
+        outside = np.abs(np.angle(np.exp(1j * (th - arc[0])))) > 0.5 * arc[1]
+        fixed[outside, :] = True
     if cavitation == "reynolds":
-        fixed = np.zeros((n_theta, n_zeta), bool)
-        if inlet == "max_film":
+        if inlet == "max_film" and arc is None:
             fixed[n_theta // 2, :] = True
         P = _solve_lcp(K, g, fixed.ravel(), None if guess is None else np.ravel(guess))
     else:
-        P = np.maximum(spsolve(K.tocsc(), g), 0.0)
+        P = np.zeros(g.size)
+        free = ~fixed.ravel()
+        P[free] = np.maximum(spsolve(K[free][:, free].tocsc(), g[free]), 0.0)
     P = P.reshape(n_theta, n_zeta)
     load = P * w[None, :] * dth                   # integral weights (trapezoid in zeta)
     force = -np.array([np.sum(load * np.cos(th)[:, None]), np.sum(load * np.sin(th)[:, None])])
@@ -184,9 +192,27 @@ class SteadyBearing:
 
 
 def steady_bearing(eps, l_over_d, n_theta=144, n_zeta=24, cavitation="reynolds",
-                   inlet="max_film"):
-    """Load, attitude angle and Sommerfeld number of a steadily loaded bearing (eps > 0)."""
-    _, _, (fr, ft) = solve_pressure(eps, l_over_d, 1.0, 0.0, n_theta, n_zeta, cavitation, inlet)
+                   inlet="max_film", arc_deg=360.0):
+    """Load, attitude angle and Sommerfeld number of a steadily loaded bearing (eps > 0).
+
+    ``arc_deg < 360``: a partial bearing of that arc, centrally loaded (the arc centre is
+    iterated onto the load line; Raimondi and Boyd's partial-bearing convention).
+    """
+    if arc_deg >= 360.0:
+        _, _, (fr, ft) = solve_pressure(eps, l_over_d, 1.0, 0.0, n_theta, n_zeta, cavitation,
+                                        inlet)
+    else:
+        width = np.radians(arc_deg)
+        centre = 0.5 * np.pi                       # first guess: load at 90 deg to the centres
+        for _ in range(200):
+            _, _, (fr, ft) = solve_pressure(eps, l_over_d, 1.0, 0.0, n_theta, n_zeta,
+                                            cavitation, arc=(centre, width))
+            load_dir = float(np.arctan2(-ft, -fr))  # the applied load balances the film force
+            if abs(load_dir - centre) < 1e-7:
+                break
+            centre = 0.5 * (centre + load_dir)
+        else:
+            raise RuntimeError("reynolds: partial-arc centre did not converge")
     load = float(np.hypot(fr, ft))
     return SteadyBearing(eps, l_over_d, load, float(np.degrees(np.arctan2(ft, -fr))),
                          1.0 / (np.pi * load))

@@ -89,7 +89,7 @@ def run(params: dict, ctx) -> dict:
              "peak_contact_force_n": float(d["fn"].max()),
              "max_penetration_m": float(max(d["penetration"].max(), 0.0)),
              "contact_fraction": float(np.mean(d["penetration"][sel] > 0.0))}
-        j.update(impact_statistics(hist.onsets[cj.name]))
+        j.update(impact_statistics(hist.onsets[cj.name], v_min=cj.v_impact_min))
         if ideal is not None:
             j["contact_loss"] = contact_loss_indicator(ideal.t[sel], ideal.joint_forces[cj.name][sel],
                                                        ideal.crank_angle[sel])
