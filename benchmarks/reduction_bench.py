@@ -1,8 +1,9 @@
-"""Craig–Bampton benchmark: the seed 000 crankshaft at ~300k P2 DOF, 8 interfaces, 60 modes.
+"""Craig–Bampton benchmark: the seed 000 crankshaft at ~300k P2 DOF, 9 interfaces, 60 modes.
 
 Interfaces: both main journals, the two crankpin rows cut into two bands each (one per rod big
-end, four rods) and both end faces — 8 interface nodes, 48 boundary DOFs. Each coupling
-(``rigid`` = RBE2-like, ``distributing`` = RBE3-like, on all eight) runs in a fresh subprocess so
+end, four rods), the two shaft-end stubs (coupling and flywheel hub seats) and the flywheel-end
+face — 9 interface nodes, 54 boundary DOFs. Each coupling
+(``rigid`` = RBE2-like, ``distributing`` = RBE3-like, on all nine) runs in a fresh subprocess so
 peak memory is its own. Wall times depend on what else runs: the process CPU time of the basis
 (both threads) and the 1-minute load average are reported beside them. Reported per run: basis time (partition, factorisation, constraint
 modes, fixed-interface modes, reduced matrices, orthonormalisation), stress modes for 60 and for
@@ -27,18 +28,19 @@ from pathlib import Path
 DEFAULT_SIZE = 0.0075  # m: ~285k P2 DOF for the four-star crankshaft
 
 
-#: interfaces of the crankshaft: 2 journals, 2 crankpin rows in 2 bands each, 2 end faces
+#: interfaces of the crankshaft: 2 journals, 2 crankpin rows in 2 bands each, 2 stubs, 1 face
 CRANK_SPECS = [{"region": "main_journal_1", "segments": 1},
                {"region": "main_journal_2", "segments": 1},
                {"region": "crankpin_1_row_1", "segments": 2},
                {"region": "crankpin_1_row_2", "segments": 2},
-               {"region": "free_end_face", "segments": 1},
+               {"region": "free_end_stub", "segments": 1},
+               {"region": "flywheel_end_stub", "segments": 1},
                {"region": "flywheel_end_face", "segments": 1}]
 BAR_SPECS = [{"region": "end_x0", "segments": 1}, {"region": "end_x1", "segments": 1}]
 
 
 def build(size: float):
-    """Part and interface specs: the crankshaft (8 interfaces) or a bar (2).
+    """Part and interface specs: the crankshaft (9 interfaces) or a bar (2).
 
     The part is the modal benchmark's (``modal_bench.py`` in this folder).
     """

@@ -25,7 +25,7 @@ def test_element_counts_fall_with_fidelity_full_dechamfered_simplified(seed000_p
 
 def test_every_bearing_region_exists_on_every_fidelity(seed000_parts):
     names = {"main_journal_1", "main_journal_2", "crankpin_1_row_1", "crankpin_1_row_2",
-             "free_end_face", "flywheel_end_face"}
+             "free_end_face", "flywheel_end_face", "free_end_stub", "flywheel_end_stub"}
     for part in seed000_parts.values():
         assert names <= set(part.regions)
         for r in part.regions.values():
@@ -89,3 +89,13 @@ def test_connecting_rod_has_bores_with_exact_cylinders():
     assert be.cylinder.radius == pytest.approx(rod.big_end_bore / 2)
     exact = math.pi * rod.big_end_bore * rod.big_end_width
     assert 0.98 * exact < be.area(part.mesh.points) <= exact * (1 + 1e-9)
+
+
+def test_shaft_end_stubs_are_cylindrical_regions_of_the_stub_diameter(seed000_parts):
+    p = SEED000
+    for name, d in (("free_end_stub", p.free_end_diameter), ("flywheel_end_stub", p.flywheel_end_diameter)):
+        for part in seed000_parts.values():
+            cyl = part.regions[name].cylinder
+            assert cyl is not None and cyl.radius == pytest.approx(d / 2, rel=1e-9)
+            pts = part.mesh.points[part.regions[name].nodes]
+            assert np.allclose(np.hypot(pts[:, 0], pts[:, 1]), d / 2, rtol=1e-6)

@@ -19,6 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import GeometryError
+from .memory import release_free_heap
 
 
 @dataclass
@@ -247,6 +248,7 @@ def assemble(part, material, timings: dict | None = None) -> FEModel:
     notes = model_warnings(points[used], order, material.nu)
     for text in notes:
         warnings.warn(text, ModelWarning, stacklevel=2)
+    release_free_heap()  # the element arrays just freed would otherwise stay resident
     return FEModel(points=points, cells=cells, order=order, K=K, M=M, material=material,
                    used=used, timings=timings, warnings=notes)
 

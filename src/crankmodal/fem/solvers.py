@@ -209,3 +209,24 @@ def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_defini
         U -= sigma * sp.triu(M, format="csr")
         return PardisoFactor(U.tocsr(), positive_definite=positive_definite, upper=True)
     return SuperLUFactor(K - sigma * M)
+
+
+def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
+                        positive_definite: bool = True):
+    """Factorise ``K[idx][:, idx]`` without a full copy of it (PARDISO: upper triangle only).
+
+    Parameters
+    ----------
+    K : scipy sparse matrix, shape (n, n)
+        Symmetric.
+    idx : ndarray of int
+        Ascending row/column indices to keep (the upper triangle of the slice is then the slice
+        of the upper triangle).
+    """
+    idx = np.asarray(idx)
+    if np.any(np.diff(idx) <= 0):
+        raise ValueError("idx must be strictly ascending")
+    if resolve_backend(backend) == "pardiso":
+        U = sp.triu(K, format="csr")[idx][:, idx]
+        return PardisoFactor(U, positive_definite=positive_definite, upper=True)
+    return SuperLUFactor(sp.csr_matrix(K)[idx][:, idx])

@@ -282,6 +282,17 @@ def _region_specs(p: CrankshaftParams, lay: CrankLayout, simplified: bool) -> li
         for k in range(p.rod_rows):
             specs.append(RegionSpec(f"crankpin_{i}_row_{k + 1}", "cylinder", axis, rp,
                                     (z0 + k * row, z0 + (k + 1) * row)))
+    # shaft-end seats (coupling / pulley hub, flywheel hub): interfaces for a drive or a rotor
+    if lay.free_end and p.free_end_diameter > 0:
+        specs.append(RegionSpec("free_end_stub", "cylinder", np.zeros(2), p.free_end_diameter / 2,
+                                lay.free_end))
+    if lay.flywheel_end and p.flywheel_end_diameter > 0:
+        z0, z1 = lay.flywheel_end
+        if lay.flywheel:
+            z1 = lay.flywheel[1] - flywheel_thickness(p, simplified)
+        if z1 > z0:
+            specs.append(RegionSpec("flywheel_end_stub", "cylinder", np.zeros(2),
+                                    p.flywheel_end_diameter / 2, (z0, z1)))
     specs.append(RegionSpec("free_end_face", "plane_z", np.zeros(2), math.inf, (0.0, 0.0)))
     specs.append(RegionSpec("flywheel_end_face", "plane_z", np.zeros(2), math.inf, (lay.length, lay.length)))
     if lay.flywheel:

@@ -166,13 +166,20 @@ def support_321(points: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     return np.sort(dofs[piv[:6]])
 
 
+#: Constraint modes solved per block of this many right-hand sides.
+CONSTRAINT_BLOCK = 18
+
+
 def _fixed_interface_modes(K, M, solver, k, G):
     """Lowest ``k`` eigenpairs of (K, M) on ker G: ARPACK shift-invert about 0 with ``solver``.
 
+    Neither sorted nor normalised (:func:`_sort_and_normalise` does that once the factor is
+    freed: the copies it makes were the memory peak of a 274k-DOF reduction).
+
     (A block shift-invert Krylov with multi-RHS solves was tried: at 60 modes it needed ~280
     vectors for residuals of 1e-5 and cost more CPU than ARPACK's ~1.5 ncv single solves.
-    ARPACK's tolerance stays at 1e-12: at 1e-9 the single-vector Lanczos returned before it had
-    found both modes of a repeated pair of a tube, and the reduced model missed them.)
+    At 60 modes ARPACK needed the same 151-153 solves for tol 1e-9 and 1e-12, and for 90 or
+    121 Lanczos vectors: the smaller basis saves 0.07 GB at the memory peak.)
     """
     from scipy.sparse.linalg import LinearOperator, eigsh
     from threadpoolctl import threadpool_limits
@@ -182,10 +189,18 @@ def _fixed_interface_modes(K, M, solver, k, G):
     v0 = np.random.default_rng(20240607).standard_normal(n)
     with threadpool_limits(limits=1, user_api="blas"):
         lam, X = eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=op, v0=v0, tol=1e-12,
-                       ncv=min(n - 1, max(2 * k + 1, k + 20)))
-    order = np.argsort(lam)
-    lam, X = lam[order], X[:, order]
-    X = X / np.sqrt(np.einsum("ij,ij->j", X, M @ X))
+                       ncv=min(n - 1, k + max(20, k // 2)))
+    return lam, X
+
+
+def _sort_and_normalise(lam, X, M, chunk: int = 8):
+    """Ascending pairs with ``xᵀMx = 1``, in place where possible (no n × k temporaries)."""
+    if np.any(np.diff(lam) < 0):
+        order = np.argsort(lam)
+        lam, X = lam[order], X[:, order]
+    for j in range(0, X.shape[1], chunk):
+        Xj = X[:, j:j + chunk]
+        Xj /= np.sqrt(np.einsum("ij,ij->j", Xj, M @ Xj))
     return lam, X
 
 
@@ -238,7 +253,7 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     CraigBamptonBasis
     """
     from ..fem.assembly import rigid_body_modes
-    from ..fem.solvers import factorize
+    from ..fem.solvers import factorize_submatrix
 
     if not interfaces:
         raise SceneError("reduction.interfaces: at least one interface is needed")
@@ -254,8 +269,8 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     I = np.flatnonzero(used)
     K = sp.csr_matrix(model.K)
     M = sp.csr_matrix(model.M)
-    K_IS_R = (K[I][:, S] @ R) if len(S) else None  # sparse, 6 m columns
-    M_II = M[I][:, I].tocsr()
+    K_IS_R = (K[I][:, S] @ R).tocsc() if len(S) else None  # sparse, 6 m columns
+    M_II = _restricted(M, I)  # through M: a copy of M_II was 0.3 GB at the memory peak
     drows, Gfull = distributing_rows(model.points, model.cells, interfaces)
     G = Gfull[:, I].tocsr()
     # a distributing surface may share a boundary line with a rigid one: G u = G_I u_I + G_S R q
@@ -266,27 +281,17 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
         support = np.searchsorted(I, support_321(model.points, pts))
         Rf = rigid_body_modes(model.points)[I]
     free = np.setdiff1d(np.arange(len(I)), support)
-    A = K[I[free]][:, I[free]].tocsr()  # the only copy of (part of) K: K_FF, or K_II
     timings["partition_s"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    try:
-        fac = factorize(A, backend, positive_definite=True)
+    try:  # K_FF (or K_II), its upper triangle only
+        fac = factorize_submatrix(K, I[free], backend, positive_definite=True)
     except np.linalg.LinAlgError as exc:
         raise NumericalError(f"reduction: factorising the interior stiffness failed ({exc}); "
                              f"the interfaces may not hold the part (a mechanism), or the mesh "
                              f"has inverted elements") from None
-    del A  # the factor holds its own copy
     solver = ConstrainedSolver(fac, G, len(I), support, Rf)
     timings["factorize_s"] = time.perf_counter() - t0
-
-    # constraint modes, all 6 m right-hand sides at once
-    t0 = time.perf_counter()
-    F = -np.asarray(K_IS_R.todense()) if len(S) else np.zeros((len(I), m6))
-    gmat = -G_SR
-    gmat[np.arange(len(drows)), drows] += 1.0
-    Psi = solver.solve(F, gmat)
-    timings["constraint_modes_s"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     K_II = _restricted(K, I)  # eigsh only needs its shape (shift-invert with OPinv)
@@ -296,7 +301,7 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
         while True:
             lam, X = _fixed_interface_modes(K_II, M_II, solver, k, G)
             f = np.sqrt(np.abs(lam)) / (2 * np.pi)
-            if f[-1] > cutoff_hz or k >= min(max_modes, n_free - 2):
+            if f.max() > cutoff_hz or k >= min(max_modes, n_free - 2):
                 break
             k = min(2 * k, max_modes, n_free - 2)
         keep = f <= cutoff_hz
@@ -309,8 +314,24 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     else:
         lam, X = np.zeros(0), np.zeros((len(I), 0))
     timings["fixed_interface_modes_s"] = time.perf_counter() - t0
+
+    # constraint modes, a few right-hand sides at a time into one array: the n × 6m dense
+    # temporaries of a one-shot solve (right-hand sides, their copies for the solver) were a
+    # memory peak. After the fixed-interface modes, so the Lanczos basis and these never meet.
+    t0 = time.perf_counter()
+    gmat = -G_SR
+    gmat[np.arange(len(drows)), drows] += 1.0
+    Psi = np.empty((len(I), m6))
+    for j in range(0, m6, CONSTRAINT_BLOCK):
+        cols = slice(j, min(j + CONSTRAINT_BLOCK, m6))
+        F = (-np.asarray(K_IS_R[:, cols].todense()) if len(S)
+             else np.zeros((len(I), cols.stop - cols.start)))
+        Psi[:, cols] = solver.solve(F, gmat[:, cols])
+    del F, gmat
+    timings["constraint_modes_s"] = time.perf_counter() - t0
     backend_name = fac.name
     del solver, fac  # release the factor (the largest allocation) before the dense products
+    lam, X = _sort_and_normalise(lam, X, M_II)
     if np.any(lam <= 0):
         raise NumericalError("reduction: a fixed-interface mode has zero frequency: the "
                              "interfaces leave a mechanism")
