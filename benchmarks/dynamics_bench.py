@@ -1,10 +1,8 @@
-"""Benchmarks and seed-trend studies of crankmodal.dynamics.
+"""Speed benchmarks of crankmodal.dynamics (the seed trends are in ``notebooks/seed_trends.py``).
 
 Usage::
 
     .venv/bin/python benchmarks/dynamics_bench.py            # speed benchmarks (about 2 min)
-    .venv/bin/python benchmarks/dynamics_bench.py --trends OUT_DIR   # seed 000 trend figures
-    .venv/bin/python benchmarks/dynamics_bench.py --wear OUT_DIR     # seed 003 wear trend
 
 Speed: (1) rigid slider-crank with one clearance joint: accepted steps per wall second and
 simulated seconds per wall second; (2) four-star compressor (seed 000 machine), one 0.1 mm
@@ -23,7 +21,7 @@ import numpy as np
 from crankmodal.dynamics import Cylinder, SolverSettings, crank_train
 from crankmodal.dynamics.analysis import simulate
 from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.signals import amplitude_spectrum, impact_statistics
+from crankmodal.dynamics.signals import impact_statistics
 from crankmodal.dynamics.simulate import integrate
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
@@ -86,122 +84,10 @@ def bench_four_star(t_end=1.0):
     return wall
 
 
-def trends(out: Path, t_end=0.3):
-    """Seed 000 Figs. 24-26 and 19/20 trends, seed 003 impact velocity against wear."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    out.mkdir(parents=True, exist_ok=True)
-    lines = []
-    base = [f"dynamics.end_time={t_end}", "dynamics.ramp_time=0.0"]
-
-    def run(extra):
-        return run_scene("four_star_dynamics.toml", base + list(extra))
-
-    # Fig. 24: clearance 0.10 / 0.15 / 0.20 mm at 1480 rpm
-    fig, ax = plt.subplots(2, 3, figsize=(14, 7))
-    spec_fig, sax = plt.subplots(figsize=(8, 4.5))
-    _, ideal = run(["dynamics.clearances=[]"])
-    sel = ideal.t > 0.1
-    sp = amplitude_spectrum(ideal.t[sel], ideal.main_bearing_force[sel], 1480 / 60)
-    sax.semilogy(sp.frequency_hz, sp.amplitude[:, 0] + 1e-3, "k", lw=0.8, label="ideal")
-    for i, c in enumerate((1.0e-4, 1.5e-4, 2.0e-4)):
-        mech, h = run([f"dynamics.clearances=[{{joint='big_end_1', clearance={c}, "
-                       "journal_radius=0.02}]"])
-        a, v = h.piston_acceleration[:, 0], h.piston_velocity[:, 0]
-        ax[0, i].plot(h.t, a, lw=0.5)
-        ax[0, i].set(title=f"clearance {c * 1e3:.2f} mm", xlabel="t [s]", ylabel="a [m/s²]")
-        ax[1, i].plot(v, a, lw=0.3)
-        ax[1, i].set(xlabel="v [m/s]", ylabel="a [m/s²]")
-        st = impact_statistics(h.onsets["big_end_1"])
-        rms_f = np.sqrt(np.mean(h.main_bearing_force[sel, 0] ** 2))
-        lines.append(f"| clearance {c * 1e3:.2f} mm, 1480 rpm | {np.abs(a[sel]).max():.0f} | "
-                     f"{st['impact_count']} | {st['impact_velocity_max']:.3f} | {rms_f:.0f} |")
-        sp = amplitude_spectrum(h.t[sel], h.main_bearing_force[sel], 1480 / 60)
-        sax.semilogy(sp.frequency_hz, sp.amplitude[:, 0] + 1e-3, lw=0.7,
-                     label=f"{c * 1e3:.2f} mm")
-    fig.tight_layout()
-    fig.savefig(out / "trend_clearance_piston_acceleration.png", dpi=110)
-    sax.set(xlim=(0, 1500), xlabel="frequency [Hz]", ylabel="main-bearing F_x amplitude [N]")
-    sax.legend()
-    spec_fig.tight_layout()
-    spec_fig.savefig(out / "trend_clearance_spectrum.png", dpi=110)
-    # Fig. 25: speed 148 / 740 / 1480 rpm at 0.1 mm
-    fig, ax = plt.subplots(1, 3, figsize=(14, 4))
-    for i, rpm in enumerate((148.0, 740.0, 1480.0)):
-        T = max(t_end, 3 * 60 / rpm)
-        mech, h = run([f"dynamics.speed_rpm={rpm}", f"dynamics.end_time={T}"])
-        st = impact_statistics(h.onsets["big_end_1"])
-        ax[i].plot(h.t, h.piston_acceleration[:, 0], lw=0.5)
-        ax[i].set(title=f"{rpm:g} rpm", xlabel="t [s]", ylabel="a [m/s²]")
-        rate = st["impact_count"] / T
-        lines.append(f"| 0.10 mm, {rpm:g} rpm | {np.abs(h.piston_acceleration[:, 0]).max():.0f} | "
-                     f"{st['impact_count']} ({rate:.0f}/s) | {st['impact_velocity_max']:.3f} | - |")
-    fig.tight_layout()
-    fig.savefig(out / "trend_speed_piston_acceleration.png", dpi=110)
-    # Figs. 19/20: friction off / on
-    fig, sx = plt.subplots(figsize=(8, 4.5))
-    for law in ("none", "coulomb"):
-        mech, h = run([f"dynamics.friction.law='{law}'"])
-        sp = amplitude_spectrum(h.t[sel], h.main_bearing_force[sel], 1480 / 60)
-        sx.semilogy(sp.frequency_hz, sp.amplitude[:, 0] + 1e-3, lw=0.7, label=f"friction {law}")
-        band = (sp.frequency_hz > 200) & (sp.frequency_hz < 1000)
-        lines.append(f"| friction {law}, 0.10 mm | - | {len(h.onsets['big_end_1'])} | - | "
-                     f"band 200-1000 Hz mean amplitude {sp.amplitude[band, 0].mean():.1f} N |")
-    sx.set(xlim=(0, 1500), xlabel="frequency [Hz]", ylabel="main-bearing F_x amplitude [N]")
-    sx.legend()
-    fig.tight_layout()
-    fig.savefig(out / "trend_friction_spectrum.png", dpi=110)
-    print("\n| case | peak piston accel [m/s²] | impacts | max impact velocity [m/s] | "
-          "RMS main-bearing F_x [N] |\n|---|---|---|---|---|")
-    print("\n".join(lines))
-
-
-def wear_trend(out: Path, t_end=0.08):
-    """Seed 003: impact velocity in the worn big-end bearing against the wear (ellipse major axis)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    out.mkdir(parents=True, exist_ok=True)
-    rows = []
-    for major in (5e-5, 1e-4, 1.5e-4, 2e-4):
-        clear = (f"dynamics.clearances=[{{joint='big_end_1', clearance=5e-5, "
-                 f"clearance_major={major}, journal_radius=0.024}}, {{joint='small_end_1', "
-                 "clearance=2.5e-5, journal_radius=0.013}]")
-        _, h = run_scene("slider_crank_dynamics.toml", [clear, f"dynamics.end_time={t_end}"])
-        st = impact_statistics(h.onsets["big_end_1"])
-        rows.append((major, st["impact_count"], st["impact_velocity_max"],
-                     st["impact_velocity_rms"], h.energy_error()))
-    print("\n| big-end wear: major-axis clearance [mm] (minor 0.05) | impacts | max impact "
-          "velocity [m/s] | RMS impact velocity [m/s] | energy balance |\n|---|---|---|---|---|")
-    for r in rows:
-        print(f"| {r[0] * 1e3:.2f} | {r[1]} | {r[2]:.3f} | {r[3]:.3f} | {r[4]:.1e} |")
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot([r[0] * 1e3 for r in rows], [r[2] for r in rows], "o-", label="max")
-    ax.plot([r[0] * 1e3 for r in rows], [r[3] for r in rows], "s-", label="RMS")
-    ax.set(xlabel="major-axis clearance of the worn big end [mm]",
-           ylabel="impact velocity [m/s]", title="seed 003: impact velocity against wear")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(out / "trend_wear_impact_velocity.png", dpi=110)
-
-
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--trends", type=Path, default=None)
-    ap.add_argument("--wear", type=Path, default=None)
     ap.add_argument("--four-star-time", type=float, default=1.0)
     a = ap.parse_args()
-    if a.trends or a.wear:
-        if a.trends:
-            trends(a.trends)
-        if a.wear:
-            wear_trend(a.wear)
-        return
     rows = bench_slider_crank()
     wall = bench_four_star(a.four_star_time)
     import json

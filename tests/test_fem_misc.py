@@ -73,3 +73,16 @@ def test_convergence_study_error_estimate_brackets_the_true_p1_error():
     assert np.all(est > 0.5 * true_err) and np.all(est < 2.0 * true_err), (est, true_err)
     for row in table.rows:
         assert row["n_dofs"] > 0 and row["wall_time_s"] > 0 and row["peak_memory_bytes"] > 0
+
+
+def test_upper_triangle_equals_scipy_triu_on_a_random_symmetric_matrix():
+    import scipy.sparse as sp
+
+    from crankmodal.fem.solvers import upper_triangle
+
+    A = sp.random(300, 300, density=0.05, format="csr", random_state=3)
+    A = (A + A.T).tocsr()
+    A.data[A.indptr[5]:A.indptr[6]] = 0.0  # a row of explicit zeros
+    U = upper_triangle(A)
+    assert U.shape == A.shape and (U != sp.triu(A)).nnz == 0
+    assert np.all(U.tocoo().col >= U.tocoo().row)

@@ -115,14 +115,14 @@ class PardisoFactor:
         self._lib = mkl.pardiso
         self._set_threads = mkl.MKL_Set_Num_Threads_Local  # C interface: int by value
         self._threads = solver_threads()
-        U = sp.csr_matrix(A) if upper else sp.triu(sp.csr_matrix(A), format="csr")
+        U = sp.csr_matrix(A) if upper else upper_triangle(A)
         U.sort_indices()
         if np.any(np.diff(U.indptr) == 0):
             raise ValueError("matrix has an empty row")
         self.n = U.shape[0]
         self._data = np.ascontiguousarray(U.data, dtype=np.float64)
-        self._ia = (U.indptr + 1).astype(np.int32)
-        self._ja = (U.indices + 1).astype(np.int32)
+        self._ia = U.indptr.astype(np.int32, copy=False)  # zero-based (iparm[34] = 1): no copies
+        self._ja = U.indices.astype(np.int32, copy=False)
         self.mtype = 2 if positive_definite else -2
         self.pt = np.zeros(64, np.int64)
         self.iparm = np.zeros(64, np.int32)
@@ -136,7 +136,11 @@ class PardisoFactor:
         ip[17] = -1  # report nnz of the factor
         ip[20] = 1   # Bunch-Kaufman pivoting (mtype -2)
         ip[23] = 1   # two-level parallel factorisation: 17.1-17.5 s against 19.8-20.1 s at 302k DOF
-        ip[34] = 0   # one-based ia/ja
+        ip[34] = 1   # zero-based ia/ja
+        if positive_definite:
+            # variable-block storage of the 3-DOF nodes: METIS orders the compressed graph
+            # (analysis 3.6 -> 1.35 s at 303k DOF) and the factor needs 0.3 GB less at its peak
+            ip[36] = -80
         self._call(12, np.zeros((self.n, 1)))
         self.factor_nnz = int(self.iparm[17])
         self.n_negative = int(self.iparm[22])
@@ -178,6 +182,16 @@ class PardisoFactor:
             pass
 
 
+def upper_triangle(A) -> sp.csr_matrix:
+    """``triu(A)`` as CSR, by masking A's CSR arrays (scipy's ``triu`` goes through COO: 5x slower)."""
+    A = sp.csr_matrix(A)
+    rows = np.repeat(np.arange(A.shape[0], dtype=A.indices.dtype), np.diff(A.indptr))
+    keep = A.indices >= rows
+    indptr = np.zeros(A.shape[0] + 1, A.indptr.dtype)
+    np.cumsum(np.bincount(rows[keep], minlength=A.shape[0]), out=indptr[1:])
+    return sp.csr_matrix((A.data[keep], A.indices[keep], indptr), shape=A.shape)
+
+
 def factorize(A, backend: str = "auto", positive_definite: bool = True):
     """Factorise a symmetric sparse matrix once.
 
@@ -205,8 +219,8 @@ def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_defini
     """
     name = resolve_backend(backend)
     if name == "pardiso":
-        U = sp.triu(K, format="csr")
-        U -= sigma * sp.triu(M, format="csr")
+        U = upper_triangle(K)
+        U -= sigma * upper_triangle(M)
         return PardisoFactor(U.tocsr(), positive_definite=positive_definite, upper=True)
     return SuperLUFactor(K - sigma * M)
 
@@ -227,6 +241,6 @@ def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
     if np.any(np.diff(idx) <= 0):
         raise ValueError("idx must be strictly ascending")
     if resolve_backend(backend) == "pardiso":
-        U = sp.triu(K, format="csr")[idx][:, idx]
+        U = upper_triangle(K)[idx][:, idx]
         return PardisoFactor(U, positive_definite=positive_definite, upper=True)
     return SuperLUFactor(sp.csr_matrix(K)[idx][:, idx])
