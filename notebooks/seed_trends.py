@@ -170,7 +170,6 @@ for j, rpm in enumerate(sorted(runs_n)):
     r, h, spec, sel = runs_n[rpm]
     t = h.t[sel]
     ax[0, j].plot((t - t[0]) * 1e3, h.piston_acceleration[sel, 0], lw=0.5)
-    ons = np.array([o for o in h.onsets["big_end_1"] if t[0] <= o[0] <= t[-1]]).reshape(-1, 2)
     ax[0, j].set(title=f"{rpm:g} rpm: {r['impacts_per_s']:.0f} impacts/s, "
                        f"mean {r['v_impact_mean']:.2f} m/s",
                  xlabel="time in window (ms)", ylabel="piston 1 accel (m/s²)")

@@ -304,15 +304,15 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             Rq = np.linalg.solve(L, Rq.T).T
             lam_r, W = np.linalg.eigh(Rq.T @ (K @ Rq))
             Xr = Rq @ W
-        locked = [Rq if deflate else np.zeros((n, 0))]  # M-orthonormal, kept out of the Krylov space
-        D, MD = locked[0], M @ locked[0]
+        R0 = Rq if deflate else np.zeros((n, 0))  # M-orthonormal, kept out of the Krylov space
+        D, MD = R0, M @ R0
 
         def project(x):
             return x - D @ (MD.T @ x) if D.shape[1] else x
 
-        def solve(b):
+        def solve(b, _fac=fac):
             n_solves[0] += 1
-            return project(fac.solve(b))
+            return project(_fac.solve(b))
 
         op = LinearOperator((n, n), matvec=solve, dtype=float)
         # with the completeness check below, a shorter basis is safe when the rigid modes are
@@ -330,7 +330,7 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                 if n - D.shape[1] - len(lam) <= COMPLETENESS_STEPS + 1:
                     break
                 Xn = X / np.sqrt(np.einsum("ij,ij->j", X, M @ X))
-                D = np.hstack([locked[0], Xn])
+                D = np.hstack([R0, Xn])
                 MD = M @ D
                 theta = top_ritz_value(solve, M, project(rng.standard_normal(n)),
                                        COMPLETENESS_STEPS)
@@ -347,7 +347,7 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                 lam, X = np.r_[lam, lam2], np.hstack([X, X2])
                 keep = np.argsort(lam)[:k]
                 lam, X = lam[keep], X[:, keep]
-            D, MD = locked[0], M @ locked[0]
+            D, MD = R0, M @ R0
         if deflate:
             lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
         backend_name = fac.name

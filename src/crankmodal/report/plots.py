@@ -34,6 +34,17 @@ def _write_csv(path: Path, header, rows) -> Path:
     return path
 
 
+def _plain_log_ticks(ax) -> None:
+    """Log axes labelled 1, 2, 5, 10, 20, ... in plain numbers (matplotlib's default labels the
+    minor ticks of a short decade as 3×10⁰, 4×10⁰, ... and they run into each other)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        axis.set_minor_formatter(NullFormatter())
+
+
 def plot_error_vs_time(study, path) -> Path:
     """Error against run time (log–log) of a :class:`~.study.SimplificationStudy`.
 
@@ -68,6 +79,7 @@ def plot_error_vs_time(study, path) -> Path:
                    zorder=4, label="recommended")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    _plain_log_ticks(ax)
     ax.set_xlabel("wall time to mesh and solve, s")
     ax.set_ylabel(f"estimated error (max over {study.compared_modes} modes), %")
     ax.set_title("Error against run time (labels: mesh size, mm)")
