@@ -326,7 +326,7 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             # completeness: a single-vector Lanczos cannot see the second mode of an exactly
             # repeated pair (an axisymmetric shaft or tube). Look below the highest mode found
             # with a few Lanczos steps from a fresh start; if one is there, hunt it down.
-            for _ in range(MAX_RESCUES + 1):
+            for attempt in range(MAX_RESCUES + 1):
                 if n - D.shape[1] - len(lam) <= COMPLETENESS_STEPS + 1:
                     break
                 Xn = X / np.sqrt(np.einsum("ij,ij->j", X, M @ X))
@@ -336,7 +336,7 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                                        COMPLETENESS_STEPS)
                 if theta <= (1 + 1e-6) / (lam.max() - sigma):
                     break
-                if _ == MAX_RESCUES:
+                if attempt == MAX_RESCUES:
                     raise NumericalError(
                         f"modal: modes below {np.sqrt(abs(lam.max())) / (2 * np.pi):.6g} Hz "
                         f"keep escaping the Lanczos iteration (repeated frequencies); ask for "
@@ -347,7 +347,6 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                 lam, X = np.r_[lam, lam2], np.hstack([X, X2])
                 keep = np.argsort(lam)[:k]
                 lam, X = lam[keep], X[:, keep]
-            D, MD = R0, M @ R0
         if deflate:
             lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
         backend_name = fac.name
