@@ -121,6 +121,15 @@ def row(label, r):
     print(f"{label:>18s} " + " ".join(f"{k}={r[k]:.4g}" for k in keys if r.get(k) is not None))
 
 
+def trace_and_phase(axes, x, h, sel, title, xlabel):
+    """First-stage piston acceleration over ``x`` (top) and its acceleration-velocity phase
+    diagram (bottom), as seed 000 Figs. 24/25 pair them."""
+    axes[0].plot(x, h.piston_acceleration[sel, 0], lw=0.5)
+    axes[0].set(title=title, xlabel=xlabel, ylabel="piston 1 accel (m/s²)")
+    axes[1].plot(h.piston_velocity[sel, 0], h.piston_acceleration[sel, 0], lw=0.3)
+    axes[1].set(xlabel="piston velocity (m/s)", ylabel="accel (m/s²)")
+
+
 # %% [markdown]
 # ### (a) and (c): clearance 0.10 / 0.15 / 0.20 mm at 1480 rpm
 
@@ -134,11 +143,8 @@ RESULTS["clearance_1480rpm"] = [r[0] for r in runs_c.values()]
 fig, ax = plt.subplots(2, 4, figsize=(16, 6.5))
 for j, (c, (r, h, spec, sel)) in enumerate(runs_c.items()):
     th = np.degrees(h.crank_angle[sel]) - np.degrees(h.crank_angle[sel][0])
-    ax[0, j].plot(th, h.piston_acceleration[sel, 0], lw=0.5)
-    ax[0, j].set(title="ideal" if c is None else f"clearance {c * 1e3:.2f} mm",
-                 xlabel="crank angle from window start (deg)", ylabel="piston 1 accel (m/s²)")
-    ax[1, j].plot(h.piston_velocity[sel, 0], h.piston_acceleration[sel, 0], lw=0.3)
-    ax[1, j].set(xlabel="piston velocity (m/s)", ylabel="accel (m/s²)")
+    trace_and_phase(ax[:, j], th, h, sel, "ideal" if c is None else f"clearance {c * 1e3:.2f} mm",
+                    "crank angle from window start (deg)")
 fig.suptitle("Seed 000 Fig. 24: first-stage piston, 1480 rpm, IMPACT + Coulomb")
 fig.tight_layout()
 fig.savefig(IMG / "dyn_clearance_acceleration.png", dpi=110)
@@ -169,12 +175,9 @@ fig, ax = plt.subplots(2, 3, figsize=(13, 6.5))
 for j, rpm in enumerate(sorted(runs_n)):
     r, h, spec, sel = runs_n[rpm]
     t = h.t[sel]
-    ax[0, j].plot((t - t[0]) * 1e3, h.piston_acceleration[sel, 0], lw=0.5)
-    ax[0, j].set(title=f"{rpm:g} rpm: {r['impacts_per_s']:.0f} impacts/s, "
-                       f"mean {r['v_impact_mean']:.2f} m/s",
-                 xlabel="time in window (ms)", ylabel="piston 1 accel (m/s²)")
-    ax[1, j].plot(h.piston_velocity[sel, 0], h.piston_acceleration[sel, 0], lw=0.3)
-    ax[1, j].set(xlabel="piston velocity (m/s)", ylabel="accel (m/s²)")
+    trace_and_phase(ax[:, j], (t - t[0]) * 1e3, h, sel,
+                    f"{rpm:g} rpm: {r['impacts_per_s']:.0f} impacts/s, "
+                    f"mean {r['v_impact_mean']:.2f} m/s", "time in window (ms)")
 fig.suptitle("Seed 000 Fig. 25: clearance 0.10 mm at three speeds")
 fig.tight_layout()
 fig.savefig(IMG / "dyn_speed_acceleration.png", dpi=110)

@@ -173,8 +173,8 @@ CONSTRAINT_BLOCK = 18
 def _fixed_interface_modes(K, M, solver, k, G):
     """Lowest ``k`` eigenpairs of (K, M) on ker G: ARPACK shift-invert about 0 with ``solver``.
 
-    Neither sorted nor normalised (:func:`_sort_and_normalise` does that once the factor is
-    freed: the copies it makes were the memory peak of a 274k-DOF reduction).
+    Neither sorted nor normalised: :func:`crankmodal.fem.modal.sort_and_normalise` does that
+    once the factor is freed (normalising here was the memory peak of a 274k-DOF reduction).
 
     (A block shift-invert Krylov with multi-RHS solves was tried: at 60 modes it needed ~280
     vectors for residuals of 1e-5 and cost more CPU than ARPACK's ~1.5 ncv single solves.
@@ -190,17 +190,6 @@ def _fixed_interface_modes(K, M, solver, k, G):
     with threadpool_limits(limits=1, user_api="blas"):
         lam, X = eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=op, v0=v0, tol=1e-12,
                        ncv=min(n - 1, k + max(20, k // 2)))
-    return lam, X
-
-
-def _sort_and_normalise(lam, X, M, chunk: int = 8):
-    """Ascending pairs with ``xᵀMx = 1``, in place where possible (no n × k temporaries)."""
-    if np.any(np.diff(lam) < 0):
-        order = np.argsort(lam)
-        lam, X = lam[order], X[:, order]
-    for j in range(0, X.shape[1], chunk):
-        Xj = X[:, j:j + chunk]
-        Xj /= np.sqrt(np.einsum("ij,ij->j", Xj, M @ Xj))
     return lam, X
 
 
@@ -253,6 +242,7 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     CraigBamptonBasis
     """
     from ..fem.assembly import rigid_body_modes
+    from ..fem.modal import sort_and_normalise
     from ..fem.solvers import factorize_submatrix
 
     if not interfaces:
@@ -331,7 +321,7 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     timings["constraint_modes_s"] = time.perf_counter() - t0
     backend_name = fac.name
     del solver, fac  # release the factor (the largest allocation) before the dense products
-    lam, X = _sort_and_normalise(lam, X, M_II)
+    lam, X = sort_and_normalise(lam, X, M_II)
     if np.any(lam <= 0):
         raise NumericalError("reduction: a fixed-interface mode has zero frequency: the "
                              "interfaces leave a mechanism")
