@@ -74,14 +74,15 @@ CRANK_TRAIN = {
 FOUR_BAR = {
     "lengths": Field("floats", [0.035, 0.075, 0.145], "crank AB, coupler BC, rocker DC, m",
                      length=3, gt=0.0),
-    "rocker_pivot": Field("floats", [0.008, 0.1598], "D relative to A, m", length=2),
+    "rocker_pivot": Field("floats", [-0.008, 0.1598], "D relative to A, m (seed 001 mirrored)",
+                           length=2),
     "masses": Field("floats", [35.8, 2.27, 10.42], "kg", length=3, gt=0.0),
-    "inertias": Field("floats", [0.0155, 0.0114, 0.0528], "kg m^2 about the centres of mass",
+    "inertias": Field("floats", [0.0155, 0.00114, 0.0528], "kg m^2 about the centres of mass",
                       length=3, ge=0.0),
     "com_fractions": Field("floats", [0.0, 0.5, 0.5], "centre of mass along crank/coupler/rocker",
                            length=3),
     "extra_rocker_inertia": Field("float", 0.3728, "sley and sword about D, kg m^2", ge=0.0),
-    "branch": Field("int", 1, "assembly mode, 1 or -1", check=lambda v: None if v in (1, -1)
+    "branch": Field("int", -1, "assembly mode, 1 or -1", check=lambda v: None if v in (1, -1)
                     else "must be 1 or -1"),
 }
 

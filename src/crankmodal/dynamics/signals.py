@@ -157,3 +157,34 @@ def contact_loss_indicator(t, f_ideal, crank_angle=None) -> dict:
         out["crank_angle_of_max_rate_deg"] = float(np.degrees(crank_angle[k]) % 360.0)
         out["crank_angle_of_min_force_deg"] = float(np.degrees(crank_angle[kmin]) % 360.0)
     return out
+
+
+def window_peaks(t, x, window) -> dict:
+    """Peaks of ``|x|`` over consecutive windows of equal length: the typical and the largest.
+
+    The largest value of a rattling signal is one event; the median of the per-window peaks
+    is what every window reaches, the robust "amplitude" to compare runs at different speeds
+    over equally long, equally sampled records.
+
+    Parameters
+    ----------
+    t : (K,) s, increasing.
+    x : (K,) signal.
+    window : float
+        Window length, s; the record is cut into ``floor(span / window)`` windows from ``t[0]``
+        (a remainder shorter than one window is dropped).
+
+    Returns
+    -------
+    dict
+        ``n_windows``, ``max``, ``median`` and ``min`` of the per-window peaks of ``|x|``.
+    """
+    t = np.asarray(t, float)
+    a = np.abs(np.asarray(x, float))
+    n = int(np.floor((t[-1] - t[0]) / window + 1e-9))
+    if n < 1:
+        raise ValueError(f"window {window} s is longer than the record ({t[-1] - t[0]} s)")
+    k = ((t - t[0]) / window + 1e-9).astype(int)            # samples past n windows: dropped
+    peaks = np.array([a[k == i].max() for i in range(n)])
+    return {"n_windows": n, "max": float(peaks.max()), "median": float(np.median(peaks)),
+            "min": float(peaks.min())}
