@@ -7,7 +7,9 @@ import pytest
 
 from crankmodal.dynamics.analysis import simulate
 from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.signals import impact_statistics
+from crankmodal.dynamics.reynolds import steady_bearing
+from crankmodal.dynamics.signals import force_direction, impact_statistics
+from crankmodal.dynamics.simulate import integrate
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
 
@@ -35,14 +37,20 @@ def test_seed000_larger_big_end_clearance_gives_larger_piston_acceleration_peaks
 
 @pytest.mark.slow
 def test_seed003_impact_velocity_in_the_worn_big_end_rises_with_wear():
-    vmax = []
-    for major in (5e-5, 2e-4):
+    cycle = 2 * 60.0 / 3000.0          # s, one four-stroke cycle of the scene's engine
+    vmax = {}
+    for major in (5e-5, 7.5e-5, 1e-4):
         h = _run("slider_crank_dynamics.toml", [
-            "dynamics.end_time=0.08",
-            f"dynamics.clearances=[{{joint='big_end_1', clearance=5e-5, clearance_major={major}, "
-            "journal_radius=0.024}, {joint='small_end_1', clearance=2.5e-5, journal_radius=0.013}]"])
-        vmax.append(impact_statistics(h.onsets["big_end_1"])["impact_velocity_max"])
-    assert vmax[1] > 1.2 * vmax[0]
+            f"dynamics.end_time={2 * cycle}",
+            (f"dynamics.clearances=[{{joint='big_end_1', clearance=5e-5, clearance_major={major}, "
+             "journal_radius=0.024}, {joint='small_end_1', clearance=2.5e-5, journal_radius=0.013}]")])
+        steady = [o for o in h.onsets["big_end_1"] if o[0] >= cycle]
+        vmax[major] = impact_statistics(steady, v_min=1e-3)["impact_velocity_max"]
+    # round bore: continuous contact, no impact above 1 mm/s once started
+    assert vmax[5e-5] == 0.0
+    # wear makes impacts, and more wear harder ones (0.14 and 0.74 m/s measured)
+    assert 0.05 < vmax[7.5e-5] < 0.5 * vmax[1e-4]
+    assert vmax[1e-4] > 0.4
 
 
 # -- seed 000 Sec. 3.2 sweeps, as in notebooks/seed_trends.py (0.1 s ramp, statistics over three
@@ -79,23 +87,102 @@ def test_seed000_fig26_clearance_broadens_the_main_bearing_spectrum_and_fig24_ra
     assert acc[0] > 3.0 * 916.0 and acc[1] > 1.3 * acc[0] and acc[2] > 1.1 * acc[1]
 
 
+def _four_star_record(rpm, friction="coulomb", span=0.405, dt=2e-5):
+    """Equal-length, equally sampled record (a 0.5-deg output step is 563 us at 148 rpm)."""
+    from crankmodal.dynamics.signals import window_peaks
+
+    t0 = 0.15
+    params = check(load_scene(SCENES / "four_star_dynamics.toml", [
+        f"dynamics.end_time={t0 + span}", "dynamics.ramp_time=0.1", f"dynamics.speed_rpm={rpm}",
+        f"dynamics.friction.law='{friction}'",
+        "dynamics.clearances=[{joint='big_end_1', clearance=1e-4, journal_radius=0.0225}]"]))
+    p = params["dynamics"]
+    mech = build_mechanism(p, params.get("mechanism"))
+    h = simulate(mech, p["end_time"], dt, solver_settings(p, 60 * mech.revolution_hz))
+    sel = h.t >= t0 - 1e-12
+    v = np.array([o[1] for o in h.onsets["big_end_1"] if o[0] >= t0 and o[1] >= 1e-3])
+    return {"acc": window_peaks(h.t[sel], h.piston_acceleration[sel, 0], 0.02),
+            "impacts_per_s": v.size / span, "v_median": float(np.median(v)), "h": h, "sel": sel,
+            "rev_hz": mech.revolution_hz}
+
+
 @pytest.mark.slow
-def test_seed000_fig25_higher_speed_gives_more_frequent_harder_impacts_than_148_rpm():
-    # impacts per second at 0.10 mm: 148 / 740 / 1480 rpm -> 442 / 798 / 854 (5 revolutions);
-    # the impact velocity rises from 148 to 740 rpm but not from 740 to 1480 rpm (not asserted)
-    r = [_four_star(1.0e-4, rpm, n_rev=n) for rpm, n in ((148.0, 1), (740.0, 3), (1480.0, 3))]
+def test_seed000_fig25_higher_speed_gives_more_frequent_and_harder_impacts():
+    # 148 / 740 / 1480 rpm, Table 4 friction: impacts/s 442 / 800 / 943; median impact velocity
+    # 0.19 / 0.32 / 0.37 m/s; median 20-ms peak of the piston acceleration 1.9k / 3.0k / 4.5k
+    # m/s^2. The largest single value is not monotonic (3.6k / 19.6k / 9.7k): at 740 rpm
+    # friction-driven chatter bursts (impacts up to 1.9 m/s) set it; not asserted.
+    r = [_four_star_record(rpm) for rpm in (148.0, 740.0, 1480.0)]
     rate = [x["impacts_per_s"] for x in r]
-    # 740 -> 1480 rpm adds only 7 %, within the scatter of three revolutions: not asserted
-    assert rate[0] < 0.8 * rate[1] and rate[0] < 0.8 * rate[2]
-    assert r[1]["v_mean"] > 1.5 * r[0]["v_mean"] and r[2]["v_mean"] > 1.3 * r[0]["v_mean"]
+    v = [x["v_median"] for x in r]
+    acc = [x["acc"]["median"] for x in r]
+    assert rate[0] < 0.8 * rate[1] and rate[1] < rate[2]
+    assert v[0] < 0.8 * v[1] and v[1] < v[2]
+    assert acc[0] < 0.8 * acc[1] and acc[1] < 0.85 * acc[2]
 
 
 @pytest.mark.slow
-def test_seed000_figs19_20_friction_broadens_the_main_bearing_band():
-    # broadband share 0.12 without and 0.24 with Table 4 Coulomb friction (0.10 mm, 1480 rpm):
-    # friction raises the mean impact velocity 0.20 -> 0.32 m/s. The seed's 225 Hz peak that
-    # friction suppresses has no counterpart in the rigid model (its largest component above
-    # 100 Hz is the 5th order line, 331 N with and without friction): not asserted
-    dry = _four_star(1.0e-4, 1480.0, friction="none")
-    fr = _four_star(1.0e-4, 1480.0)
-    assert fr["broadband"] > 1.3 * dry["broadband"]
+def test_seed000_figs19_20_friction_raises_the_contact_band_and_leaves_the_first_order():
+    # 1480 rpm, 0.10 mm, 10 revolutions: first order 4551 / 4553 N (ideal 4550); 500-1000 Hz
+    # RMS 949 -> 1517 N (peak 307 N at 868 Hz -> 673 N at 898 Hz: the rod rocking on the
+    # contact, sqrt(F / (c m_t)) / 2 pi); 1000-2000 Hz 696 -> 1627 N. The seed's 225 Hz peak
+    # that friction suppresses is not reproduced (200-250 Hz: the 9th order, 58 / 54 N, as the
+    # ideal model's 58 N): not asserted.
+    from crankmodal.dynamics.signals import amplitude_spectrum
+
+    out = {}
+    for fr in ("none", "coulomb"):
+        x = _four_star_record(1480.0, fr)
+        h, sel = x["h"], x["sel"]
+        s = amplitude_spectrum(h.t[sel], h.main_bearing_force[sel, 0], x["rev_hz"])
+        f, A = s.frequency_hz, s.amplitude
+        rms = [float(np.sqrt(np.sum(A[(f >= lo) & (f < hi)] ** 2) / 3.0))  # Hann: 1.5 bins
+               for lo, hi in ((500.0, 1000.0), (1000.0, 2000.0))]
+        out[fr] = (float(A[np.argmin(np.abs(s.order - 1.0))]), *rms)
+    assert out["coulomb"][0] == pytest.approx(out["none"][0], rel=0.01)
+    assert out["coulomb"][1] > 1.3 * out["none"][1] and out["coulomb"][2] > 1.5 * out["none"][2]
+
+
+@pytest.mark.slow
+def test_seed001_loom_journal_enters_the_eps_0p1_circle_at_the_seed_crank_angles():
+    # Seed 001 Sec. 2.2/3: the quasi-static journal centre (Table 3 inverted at the zero-clearance
+    # C force) comes inside eps = 0.1 around 92 deg (seed: 72-114 deg, eps 0.001) and 322 deg
+    # (seed: 302-338 deg, eps 0.004), where the force direction also changes fastest; the
+    # lubricated dynamic run stays off the wall with its energy balance closed. (The seed's third,
+    # shallow entry at 178-192 deg, eps 0.098, is not reproduced with Table 2's numbers.)
+    params = check(load_scene(SCENES / "loom_four_bar_dynamics.toml", [
+        "dynamics.end_time=0.4",
+        ("dynamics.clearances=[{joint='C', clearance=2.1e-5, journal_radius=0.02, "
+         "viscosity=0.0175, bearing_length=0.042}]")]))
+    p = params["dynamics"]
+    mech = build_mechanism(p)
+    settings = solver_settings(p, 60 * mech.revolution_hz)
+    dt = 1.0 / (720 * mech.revolution_hz)
+    ideal = simulate(mech, p["end_time"], dt, settings, ideal=True)
+    hist = simulate(mech, p["end_time"], dt, settings)            # raises if the balance fails
+    integ = integrate(mech.ideal, mech.q0, mech.qd0, p["end_time"], ideal.t, settings)
+    n = mech.ideal.n
+    w = {b.name: integ.y[n + mech.ideal.slices[id(b)].start + 2] for b in mech.ideal.bodies}
+    last = ideal.t >= ideal.t[-1] - 1.0 / mech.revolution_hz - 1e-12
+    deg = np.degrees(ideal.crank_angle[last]) % 360.0
+    F = ideal.joint_forces["C"]
+    _, rate = force_direction(ideal.t, F)
+    w_eq = (w["coupler"] + w["rocker"] - 2.0 * rate)[last]        # film speed: seed's U_bc + U_cd
+    R, L, cl, mu = 0.02, 0.042, 2.1e-5, 0.0175
+    X = (np.hypot(F[last, 0], F[last, 1]) * (cl / R) ** 2
+         / (mu * R * np.maximum(np.abs(w_eq), 1e-12) * L))
+    eps_grid = np.concatenate([[0.0], np.linspace(0.05, 0.95, 19)])
+    load = np.array([0.0] + [steady_bearing(e, 1.0, 96, 16, arc_deg=150.0).load
+                             for e in eps_grid[1:]])
+    eps = np.interp(X, load, eps_grid, right=1.0)
+    for lo, hi, centre in ((72, 114, 92), (302, 338, 322)):
+        sel = (deg >= lo) & (deg <= hi)
+        k = np.flatnonzero(sel)[np.argmin(eps[sel])]
+        assert deg[k] == pytest.approx(centre, abs=8.0)
+        assert eps[k] < 0.01                                           # seed: 0.001 and 0.004
+        fast = np.flatnonzero(sel)[np.argmax(np.abs(rate[last][sel]))]
+        assert deg[fast] == pytest.approx(centre, abs=8.0)
+    # away from the two events the film carries the load far from the centre (seed Fig. 7)
+    assert eps[(deg > 130) & (deg < 290)].min() > 0.3
+    ecc = np.hypot(hist.contact["C"]["ex"], hist.contact["C"]["ey"]) / cl
+    assert np.all(np.isfinite(ecc)) and ecc.max() < 1.0
