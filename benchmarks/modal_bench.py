@@ -121,7 +121,7 @@ def main(argv=None):
             med["mesh_s"] = max(r["mesh_s"] for r in reps if not r["mesh_cached"]) \
                 if any(not r["mesh_cached"] for r in reps) else float("nan")
             rows.append({**reps[0], **med, "repeats": len(reps)})
-    cols = ("n_dofs", "backend", "mesh_s", "assembly_s", "factorize_s", "eigsh_s", "modal_s",
+    cols = ("n_dofs", "backend", "mesh_s", "assembly_s", "factorize_s", "lanczos_s", "modal_s",
             "peak_gb")
     print("| part | " + " | ".join(cols) + " | f1..f4 Hz |")
     print("|" + "---|" * (len(cols) + 2))

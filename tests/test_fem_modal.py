@@ -185,7 +185,7 @@ def test_bars_joined_at_one_corner_point_reveal_the_hinge_the_connectivity_hides
 
 
 def test_deflating_the_known_rigid_modes_changes_nothing_but_the_work(bar_model, free_modes):
-    plain = modal.solve_modes(bar_model[1], 8, expected_rigid=6)  # rigid modes found by ARPACK
+    plain = modal.solve_modes(bar_model[1], 8, expected_rigid=6)  # rigid modes found by Lanczos
     np.testing.assert_allclose(free_modes.frequencies_hz, plain.frequencies_hz, rtol=1e-9)
     assert free_modes.n_solves < plain.n_solves
     mac = np.abs(np.sum(free_modes.shapes * (bar_model[1].M @ plain.shapes), axis=0))
@@ -200,3 +200,80 @@ def test_repeated_pairs_of_a_tube_are_both_found_when_few_modes_are_asked():
     for n in (1, 2, 3, 4):
         np.testing.assert_allclose(modal.solve_modes(model, n).frequencies_hz, many[:n],
                                    rtol=1e-8)
+
+
+def _pencil(n=60, seed=3):
+    """A small SPD pencil (K, M) with distinct eigenvalues, and its dense solution."""
+    import scipy.linalg as sla
+    import scipy.sparse as sp
+
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    K = A @ A.T + n * np.eye(n)
+    B = rng.standard_normal((n, n))
+    M = B @ B.T / n + np.eye(n)
+    return sp.csr_matrix(K), sp.csr_matrix(M), sla.eigh(K, M)
+
+
+def test_lanczos_matches_a_dense_generalised_eigensolver():
+    K, M, (lam_ref, X_ref) = _pencil()
+    sigma = -1.0
+    S = np.linalg.inv((K - sigma * M).toarray())
+    out = modal.lanczos(lambda b: S @ b, M, np.ones(K.shape[0]), 5, 1e-12, 59)
+    assert out.converged
+    lam = np.sort(sigma + 1.0 / out.theta)
+    np.testing.assert_allclose(lam, lam_ref[:5], rtol=1e-10)
+    X = out.vectors
+    np.testing.assert_allclose(X.T @ (M @ X), np.eye(5), atol=1e-10)  # M-orthonormal
+    np.testing.assert_allclose(out.m_vectors, M @ X, atol=1e-10)
+    r = K @ X - (M @ X) * (sigma + 1.0 / out.theta)
+    assert np.linalg.norm(r, axis=0).max() < 1e-8 * np.abs(K).max()
+
+
+def test_lanczos_restarts_when_the_krylov_space_closes_and_accept_can_ask_for_more():
+    import scipy.sparse as sp
+
+    n = 40
+    d = np.arange(1.0, n + 1.0)
+    K, M = sp.diags(d).tocsr(), sp.identity(n, format="csr")
+    v0 = np.zeros(n)
+    v0[[0, 5, 9]] = 1.0  # the Krylov space of v0 is 3-dimensional
+    apply = lambda b: b / d  # noqa: E731 - (K - 0 M)^-1
+    closed = modal.lanczos(apply, M, v0, 4, 1e-12, 20)
+    assert not closed.converged and closed.steps == 3  # nothing left to explore
+    rng = np.random.default_rng(0)
+    fresh = modal.lanczos(apply, M, v0, 4, 1e-12, 39, fresh=lambda: rng.standard_normal(n))
+    assert fresh.converged
+    np.testing.assert_allclose(np.sort(1.0 / fresh.theta), [1.0, 2.0, 3.0, 4.0], rtol=1e-10)
+    calls = []
+    picky = modal.lanczos(apply, M, rng.standard_normal(n), 2, 1e-6, 39,
+                          accept=lambda th, X, MX: calls.append(len(calls)) or len(calls) > 2)
+    assert picky.converged and len(calls) == 3  # asked three times, went on twice
+
+
+def test_lanczos_needs_no_more_solves_than_arpack_for_the_same_modes(bar_model):
+    """The per-step convergence check: never more operator applications than ARPACK's restarts."""
+    from scipy.sparse.linalg import LinearOperator, eigsh
+
+    from crankmodal.fem.solvers import factorize_shifted
+
+    model = bar_model[1]
+    K, M = model.K, model.M
+    sigma = modal.default_shift(K, M)
+    fac = factorize_shifted(K, M, sigma)
+    count = [0]
+
+    def solve(b):
+        count[0] += 1
+        return fac.solve(b)
+
+    n, k = K.shape[0], 14  # 6 rigid + 8 elastic
+    v0 = np.random.default_rng(1).standard_normal(n)
+    lam_a, _ = eigsh(K, k=k, M=M, sigma=sigma, OPinv=LinearOperator((n, n), solve), v0=v0,
+                     tol=1e-10, ncv=2 * k + 1)
+    arpack = count[0]
+    count[0] = 0
+    out = modal.lanczos(solve, M, v0, k, 1e-10, 200)
+    assert out.converged and count[0] <= arpack
+    np.testing.assert_allclose(np.sort(sigma + 1.0 / out.theta)[6:], np.sort(lam_a)[6:],
+                               rtol=1e-8)

@@ -1,10 +1,10 @@
 """Free and supported modal analysis: shift-invert Lanczos with one sparse factorisation.
 
-The pencil (K, M) is solved with ARPACK in shift-invert mode about a small *negative* shift σ:
+The pencil (K, M) is solved by shift-invert Lanczos (:func:`lanczos`) about a small *negative* shift σ:
 ``K - σM`` is then positive definite even for a free part (its rigid-body modes sit at λ = 0 > σ),
 so one Cholesky/LDLᵀ serves every Lanczos step. The rigid-body motions the supports leave (6 per
 connected free piece) are known in closed form: they are M-orthonormalised, their Rayleigh
-quotients checked like any other pair, and deflated from the Lanczos operator, so ARPACK only
+quotients checked like any other pair, and deflated from the Lanczos operator, so Lanczos only
 looks for elastic modes (a quarter fewer solves). A zero-frequency mode among those — a loose
 piece or a mechanism the connectivity did not predict — is caught by the rigid-count check. Every returned pair is checked:
 ``‖Kx − λMx‖ / ‖Kx‖`` and ``|XᵀMX − I|``; poor results raise :class:`NumericalError` with advice.
@@ -23,9 +23,10 @@ from .assembly import FEModel, mass_and_centre, rigid_body_modes
 from .memory import PeakMemory
 from .supports import Support, reduce_matrix, reduction
 
-#: ARPACK's convergence tolerance: residuals come out near 1e-8, far inside the 1e-6 check,
-#: with a third fewer solves than at 1e-12.
-ARPACK_TOL = 1e-9
+#: Lanczos tolerance on ‖Ay − θy‖_M / θ. For the seed 000 crank the pair residuals
+#: ‖Kx − λMx‖/‖Kx‖ come out at 1e-8 (37 solves), 100x inside the 1e-6 check; 1e-9 gives 2e-7
+#: (36 solves), 1e-8 fails the check (2e-6, 35 solves).
+LANCZOS_TOL = 1e-10
 
 #: Lanczos steps of the check for modes the main run missed (the second of a repeated pair).
 COMPLETENESS_STEPS = 8
@@ -168,34 +169,135 @@ def sort_and_normalise(lam: np.ndarray, X: np.ndarray, M, chunk: int = 8):
     return lam, X
 
 
-def top_ritz_value(apply, M, v: np.ndarray, steps: int) -> float:
-    """Largest Ritz value of ``steps`` Lanczos steps of ``x -> apply(M x)`` in the M-inner product.
+@dataclass
+class Lanczos:
+    """Outcome of :func:`lanczos`.
 
-    A lower bound of the largest eigenvalue of the M-self-adjoint operator, close to it after a
-    few steps when it stands apart (the check for eigenpairs a Lanczos run has missed). Fully
-    reorthogonalised, so ``steps`` vectors of length n are kept.
+    Attributes
+    ----------
+    theta : ndarray, shape (k,)
+        The k largest Ritz values of the operator, descending.
+    vectors : ndarray, shape (n, k)
+        Their Ritz vectors, M-orthonormal.
+    m_vectors : ndarray, shape (n, k)
+        M times them (from the kept M Q: no product with M).
+    residuals : ndarray, shape (k,)
+        Residual norms ``‖A y − θ y‖_M`` (from the Lanczos relation, no extra products).
+    steps : int
+        Operator applications (solves) made.
+    converged : bool
+        Every residual is at most ``tol θ`` (and ``accept`` agreed).
     """
-    Q = np.zeros((len(v), steps + 1))
-    MQ = np.zeros_like(Q)  # M Q, kept so that each step costs one product with M
-    Mv = M @ v
-    nv = np.sqrt(v @ Mv)
-    Q[:, 0], MQ[:, 0] = v / nv, Mv / nv
-    alpha, beta = [], []
-    for j in range(steps):
+
+    theta: np.ndarray
+    vectors: np.ndarray
+    m_vectors: np.ndarray
+    residuals: np.ndarray
+    steps: int
+    converged: bool
+
+
+def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
+            fresh=None, accept=None) -> Lanczos:
+    """Largest eigenpairs of the M-self-adjoint operator ``A x = apply(M x)``.
+
+    Lanczos in the M-inner product with full reorthogonalisation (twice, against every basis
+    vector), checked at *every* step: it stops at the first step at which each of the ``k``
+    largest Ritz pairs has ``‖A y − θ y‖_M ≤ tol θ``. For shift-invert (``apply = (K − σM)⁻¹``)
+    these are the eigenvalues of (K, M) nearest σ, ``λ = σ + 1/θ``. ARPACK, which checks only
+    after each restart cycle of ``ncv`` vectors, needed 40 solves for the 12 modes of the seed
+    000 crank (the 36 of this loop only with a lucky ``ncv``).
+
+    Parameters
+    ----------
+    apply : callable
+        ``b -> A' b`` with ``A = A' M`` (one factorisation solve, plus any deflation).
+    M : sparse matrix, shape (n, n)
+        Mass matrix, symmetric positive (semi-)definite on the space ``apply`` maps into.
+    v0 : ndarray, shape (n,)
+        Start vector (in the range of ``apply``).
+    k : int
+        Wanted pairs.
+    tol : float
+        Relative residual; 0 runs exactly ``max_steps`` steps.
+    max_steps : int
+        Most operator applications; the basis (and ``M`` times it) is kept: 2 n max_steps floats.
+    fresh : callable, optional
+        ``() -> vector`` for a new start direction when the Krylov space closes (an invariant
+        subspace, e.g. a small model or an exact repeated eigenvalue) before ``k`` pairs are found.
+    accept : callable, optional
+        ``(theta, X, MX) -> bool``, asked once the Lanczos estimates are within ``tol``; ``False``
+        continues the iteration. The estimate bounds the residual of the operator, not
+        ``‖Kx − λMx‖`` (which weighs the residual's stiff part: 3e4 times larger for a clamped
+        beam), so the modal solve checks the pencil's residuals here.
+
+    Returns
+    -------
+    Lanczos
+    """
+    n = len(v0)
+    cap = max_steps + 1
+    # column-major: a column is contiguous, and the pages of columns never reached stay unmapped
+    Q = np.empty((n, cap), order="F")
+    MQ = np.empty((n, cap), order="F")  # M Q, kept so each step costs one product with M
+    alpha, beta = np.zeros(cap), np.zeros(cap)
+
+    def start(j, v):
+        """Put v, M-orthogonalised against Q[:, :j], in column j; False if nothing is left."""
+        Mv = M @ v
+        for _ in range(2):
+            if j:
+                c = Q[:, :j].T @ Mv
+                v = v - Q[:, :j] @ c
+                Mv = Mv - MQ[:, :j] @ c
+        nv = float(np.sqrt(max(v @ Mv, 0.0)))
+        if not np.isfinite(nv) or nv == 0.0:
+            return False
+        Q[:, j], MQ[:, j] = v / nv, Mv / nv
+        return True
+
+    if not start(0, np.asarray(v0, float)):
+        raise NumericalError("modal: the Lanczos start vector is zero or not finite")
+    theta = Y = res = None
+    steps = 0
+    for j in range(max_steps):
         w = apply(MQ[:, j])
+        steps += 1
         Mw = M @ w
-        alpha.append(float(Q[:, j] @ Mw))
-        for _ in range(2):  # full reorthogonalisation, twice is enough
-            c = Q[:, :j + 1].T @ Mw
+        alpha[j] = float(Q[:, j] @ Mw)
+        norm = float(np.sqrt(max(w @ Mw, 0.0)))
+        for _ in range(2):  # full reorthogonalisation; a second pass when the first cancelled
+            c = Q[:, :j + 1].T @ Mw  # most of w (Kahan-Parlett: "twice is enough")
             w -= Q[:, :j + 1] @ c
             Mw -= MQ[:, :j + 1] @ c
-        b = float(np.sqrt(max(w @ Mw, 0.0)))
-        if b <= 1e-12 * abs(alpha[-1]) or j == steps - 1:
+            b, before = float(np.sqrt(max(w @ Mw, 0.0))), norm
+            norm = b
+            if b > 0.7071 * before:
+                break
+        m = j + 1
+        T = np.diag(alpha[:m]) + np.diag(beta[1:m], 1) + np.diag(beta[1:m], -1)
+        theta, Y = np.linalg.eigh(T)
+        theta, Y = theta[::-1][:k], Y[:, ::-1][:, :k]
+        res = b * np.abs(Y[-1])
+        scale = np.abs(theta).max()
+        done = len(theta) == k and tol > 0 and bool(np.all(res <= tol * np.abs(theta)))
+        X = MX = None
+        if done and accept is not None:
+            X, MX = Q[:, :m] @ Y, MQ[:, :m] @ Y
+            done = bool(accept(theta, X, MX))
+        if done or m == max_steps:
             break
-        beta.append(b)
-        Q[:, j + 1], MQ[:, j + 1] = w / b, Mw / b
-    T = np.diag(alpha) + np.diag(beta, 1) + np.diag(beta, -1)
-    return float(np.linalg.eigvalsh(T).max())
+        if b > 1e-13 * scale:
+            Q[:, m], MQ[:, m] = w / b, Mw / b
+            beta[m] = b
+        else:  # the Krylov space closed: its Ritz pairs are exact; go on from a new direction
+            if fresh is None or not start(m, fresh()):
+                break
+            beta[m] = 0.0
+    if X is None:
+        X, MX = Q[:, :steps] @ Y, MQ[:, :steps] @ Y
+    return Lanczos(theta=theta, vectors=X, m_vectors=MX, residuals=res, steps=steps,
+                   converged=done)
 
 
 def default_shift(K, M) -> float:
@@ -204,7 +306,24 @@ def default_shift(K, M) -> float:
     return -1e-8 * float(np.median(d[d > 0]))
 
 
-def check_pairs(K, M, lam, X, tol: float = 1e-6, shift: float = 0.0,
+def pair_residuals(KX: np.ndarray, MX: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """``‖Kx − λMx‖ / ‖Kx‖`` of each pair; zero-frequency pairs relative to the first elastic one.
+
+    A rigid-body mode has ``Kx ≈ 0``: its residual is measured against ``λ_e ‖Mx‖`` with λ_e the
+    smallest eigenvalue above ``RIGID_RATIO`` of the largest frequency, i.e. its strain energy
+    must be ``tol`` of the first elastic mode's. (Against the shift |σ| ~ 1e-8 λ it would demand
+    rounding-free vectors: the stiff part of a 1e-16 noise is ~1e-6 of |σ|.)
+    """
+    lam = np.asarray(lam, float)
+    f = np.sqrt(np.abs(lam))
+    elastic = f >= RIGID_RATIO * f.max() if len(f) else f > 0
+    lam_e = lam[elastic].min() if np.any(elastic) else (np.abs(lam).max() or 1.0)
+    num = np.linalg.norm(KX - MX * lam, axis=0)
+    den = np.maximum(np.linalg.norm(KX, axis=0), abs(lam_e) * np.linalg.norm(MX, axis=0))
+    return num / np.where(den > 0, den, 1.0)
+
+
+def check_pairs(K, M, lam, X, tol: float = 1e-6,
                 what: str = "modal") -> tuple[np.ndarray, float]:
     """Residuals ‖Kx − λMx‖/‖Kx‖ and M-orthogonality of eigenpairs; raise when poor.
 
@@ -215,9 +334,7 @@ def check_pairs(K, M, lam, X, tol: float = 1e-6, shift: float = 0.0,
     X : ndarray, shape (n, k)
         Mass-normalised vectors.
     tol : float
-        Largest admissible residual and |XᵀMX − I|.
-    shift : float
-        |σ| used to scale the residual of (near) zero eigenvalues, whose ‖Kx‖ vanishes.
+        Largest admissible residual (:func:`pair_residuals`) and |XᵀMX − I|.
 
     Returns
     -------
@@ -227,11 +344,8 @@ def check_pairs(K, M, lam, X, tol: float = 1e-6, shift: float = 0.0,
     ------
     NumericalError
     """
-    KX = K @ X
     MX = M @ X
-    num = np.linalg.norm(KX - MX * lam, axis=0)
-    den = np.maximum(np.linalg.norm(KX, axis=0), abs(shift) * np.linalg.norm(MX, axis=0))
-    res = num / np.where(den > 0, den, 1.0)
+    res = pair_residuals(K @ X, MX, lam)
     G = X.T @ MX
     orth = float(np.abs(G - np.eye(len(lam))).max())
     worst = int(np.argmax(res)) if len(res) else 0
@@ -277,7 +391,6 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
     -------
     Modes
     """
-    from scipy.sparse.linalg import LinearOperator, eigsh
     from threadpoolctl import threadpool_limits
 
     from .solvers import factorize_shifted
@@ -329,26 +442,42 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             n_solves[0] += 1
             return project(_fac.solve(b))
 
-        op = LinearOperator((n, n), matvec=solve, dtype=float)
-        # with the completeness check below, a shorter basis is safe when the rigid modes are
-        # deflated (40 instead of 43 solves for 12 modes of the seed 000 crank)
-        ncv = min(n - 1, max(2 * k + 1, 20 if deflate else k + 20))
-        # one BLAS thread for ARPACK's small dense work (two were 5-7x slower); PARDISO sets
-        # its own MKL threads per call
+        def fresh():
+            return project(rng.standard_normal(n))
+
+        def accept(theta, X, MX):
+            """Pencil residuals of the candidate pairs 10x inside the final check (zero-frequency
+            ones, whose residual is a rounding floor that more steps do not lower: inside it)."""
+            lam_c = sigma + 1.0 / theta
+            f = np.sqrt(np.abs(lam_c))
+            margin = np.where(f < RIGID_RATIO * f.max(), 1.0, 0.1)
+            return bool(np.all(pair_residuals(K @ X, MX, lam_c) <= margin * tol))
+
+        def run(apply, k_run, v0):
+            """Lowest k_run modes of the deflated pencil (raises when Lanczos does not converge)."""
+            steps = min(n - D.shape[1], max(4 * k_run + 40, 60))
+            out = lanczos(apply, M, v0, k_run, LANCZOS_TOL, steps, fresh=fresh, accept=accept)
+            if not out.converged:
+                raise NumericalError(
+                    f"modal: {k_run} modes did not converge in {out.steps} Lanczos steps "
+                    f"(largest relative residual {np.max(out.residuals / np.abs(out.theta)):.1e});"
+                    f" check the mesh for loose or degenerate elements, or ask for fewer modes")
+            return out
+
+        # one BLAS thread for the small dense work of the loop (two were 5-7x slower); PARDISO
+        # sets its own MKL threads per call
         with threadpool_limits(limits=1, user_api="blas"):
-            lam, X = eigsh(K, k=k, M=M, sigma=sigma, which="LM", OPinv=op,
-                           v0=project(rng.standard_normal(n)), tol=ARPACK_TOL, ncv=ncv)
+            main = run(solve, k, fresh())
+            lam, X, MX = sigma + 1.0 / main.theta, main.vectors, main.m_vectors
             # completeness: a single-vector Lanczos cannot see the second mode of an exactly
             # repeated pair (an axisymmetric shaft or tube). Look below the highest mode found
             # with a few Lanczos steps from a fresh start; if one is there, hunt it down.
             for attempt in range(MAX_RESCUES + 1):
                 if n - D.shape[1] - len(lam) <= COMPLETENESS_STEPS + 1:
                     break
-                lam, X = sort_and_normalise(lam, X, M)
-                D = np.hstack([R0, X])
-                MD = M @ D
-                theta = top_ritz_value(solve, M, project(rng.standard_normal(n)),
-                                       COMPLETENESS_STEPS)
+                D = np.hstack([R0, X])  # M-orthonormal: the Lanczos vectors are
+                MD = np.hstack([M @ R0, MX])
+                theta = lanczos(solve, M, fresh(), 1, 0.0, COMPLETENESS_STEPS).theta[0]
                 if theta <= (1 + 1e-6) / (lam.max() - sigma):
                     break
                 if attempt == MAX_RESCUES:
@@ -356,21 +485,22 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                         f"modal: modes below {np.sqrt(abs(lam.max())) / (2 * np.pi):.6g} Hz "
                         f"keep escaping the Lanczos iteration (repeated frequencies); ask for "
                         f"more modes (n_modes) or break the part's symmetry slightly")
-                lam2, X2 = eigsh(K, k=min(k, n - D.shape[1] - 2), M=M, sigma=sigma,
-                                 which="LM", OPinv=op, v0=project(rng.standard_normal(n)),
-                                 tol=ARPACK_TOL, ncv=min(n - D.shape[1] - 1, ncv))
-                lam, X = np.r_[lam, lam2], np.hstack([X, X2])
+                extra = run(solve, min(k, n - D.shape[1] - 2), fresh())
+                lam = np.r_[lam, sigma + 1.0 / extra.theta]
                 keep = np.argsort(lam)[:k]
-                lam, X = lam[keep], X[:, keep]
+                lam = lam[keep]
+                X = np.hstack([X, extra.vectors])[:, keep]
+                MX = np.hstack([MX, extra.m_vectors])[:, keep]
         if deflate:
             lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
         backend_name = fac.name
-        del op, solve, fac  # free the factor before the checks' n × k products
-        timings["eigsh_s"] = time.perf_counter() - t0
+        del solve, fac  # free the factor before the checks' n × k products
+        timings["lanczos_s"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()
-        lam, X = sort_and_normalise(lam, X, M)
-        res, orth = check_pairs(K, M, lam, X, tol=tol, shift=sigma)
+        order = np.argsort(lam)  # M-orthonormal already (Lanczos, rigid basis): check_pairs checks
+        lam, X = lam[order], X[:, order]
+        res, orth = check_pairs(K, M, lam, X, tol=tol)
         f = np.sqrt(np.abs(lam)) / (2 * np.pi)
         rigid = f < RIGID_RATIO * f.max()
         n_rigid = int(rigid.sum())
