@@ -37,6 +37,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
+from ..errors import NumericalError
+
 CAVITATION = ("reynolds", "half_sommerfeld")
 INLETS = ("max_film", "free")
 
@@ -95,7 +97,9 @@ def _solve_lcp(K, g, fixed, guess=None, max_iter=200):
         if np.array_equal(new, active):
             return P
         active = new
-    raise RuntimeError("reynolds: active-set cavitation loop did not converge")
+    raise NumericalError(
+        f"reynolds: the cavitation active set did not settle in {max_iter} iterations; use a "
+        f"finer grid (n_theta, n_zeta) or an eccentricity below 0.99")
 
 
 def solve_pressure(eps, l_over_d, rotation=1.0, squeeze=0.0, n_theta=144, n_zeta=24,
@@ -212,7 +216,9 @@ def steady_bearing(eps, l_over_d, n_theta=144, n_zeta=24, cavitation="reynolds",
                 break
             centre = 0.5 * (centre + load_dir)
         else:
-            raise RuntimeError("reynolds: partial-arc centre did not converge")
+            raise NumericalError(
+                f"reynolds: the load line of the {arc_deg:g}-degree arc did not settle for "
+                f"eccentricity {eps}; use a wider arc or a finer grid")
     load = float(np.hypot(fr, ft))
     return SteadyBearing(eps, l_over_d, load, float(np.degrees(np.arctan2(ft, -fr))),
                          1.0 / (np.pi * load))

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import NumericalError
 from . import fastpath
 from .bodies import Ground, RigidBody
 from .joints import AngleDrive
@@ -239,7 +240,11 @@ class Multibody:
                 break
             q -= np.linalg.lstsq(Cq, phi, rcond=None)[0]
         else:
-            raise RuntimeError("assembly did not converge")
+            raise NumericalError(
+                f"dynamics: the mechanism cannot be assembled at t = {t} s (constraint residual "
+                f"{np.max(np.abs(phi)):.1e} after {max_iter} Newton steps); check that the link "
+                f"lengths close (a four-bar must satisfy the triangle inequalities at every crank "
+                f"angle) and the assembly branch")
         _, Cq, nu, _ = self.constraint_terms(t, q, np.zeros(self.n))
         qd = np.array(qd0, float)
         if self.m:
