@@ -265,9 +265,16 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
         steps += 1
         Mw = M @ w
         alpha[j] = float(Q[:, j] @ Mw)
+        # the three-term recurrence first (two vectors), then full reorthogonalisation, which
+        # then only removes rounding: a second pass is rarely needed (each pass reads the basis)
+        w -= alpha[j] * Q[:, j]
+        Mw -= alpha[j] * MQ[:, j]
+        if j:
+            w -= beta[j] * Q[:, j - 1]
+            Mw -= beta[j] * MQ[:, j - 1]
         norm = float(np.sqrt(max(w @ Mw, 0.0)))
-        for _ in range(2):  # full reorthogonalisation; a second pass when the first cancelled
-            c = Q[:, :j + 1].T @ Mw  # most of w (Kahan-Parlett: "twice is enough")
+        for _ in range(2):  # a second pass when the first cancelled (Kahan-Parlett: "twice is
+            c = Q[:, :j + 1].T @ Mw  # enough")
             w -= Q[:, :j + 1] @ c
             Mw -= MQ[:, :j + 1] @ c
             b, before = float(np.sqrt(max(w @ Mw, 0.0))), norm
