@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import GeometryError, SceneError
+from ..errors import SceneError
+from ..topology import facet_midnodes
 
 _TET_FACES = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
 _TET_OPPOSITE = np.array([3, 2, 1, 0])
-#: tetra10 edges in meshio's (VTK) node order, nodes 4..9.
-TET10_EDGES = np.array([[0, 1], [1, 2], [0, 2], [0, 3], [1, 3], [2, 3]])
 # degree-4 rule on the reference triangle (Strang-Fix / Dunavant, 6 points), weights sum to 1/2
 _A, _B = 0.445948490915965, 0.091576213509771
 _QX = np.array([[_A, _A], [1 - 2 * _A, _A], [_A, 1 - 2 * _A],
@@ -25,26 +24,6 @@ _QW = 0.5 * np.array([0.223381589678011] * 3 + [0.109951743655322] * 3)
 def _keys(a, n):
     a = np.sort(a, axis=-1).astype(np.int64)
     return (a[..., 0] * n + a[..., 1]) * n + a[..., 2]
-
-
-def facet_midnodes(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """Mid-side nodes of corner triangles of a ``tetra10`` mesh, shape (n_facets, 3).
-
-    Column k is the node on edge (k, k+1 mod 3) of each triangle. Raises GeometryError if an
-    edge is not an element edge.
-    """
-    n = int(cells.max()) + 1
-    e = np.sort(cells[:, TET10_EDGES], axis=2).reshape(-1, 2)
-    keys = e[:, 0].astype(np.int64) * n + e[:, 1]
-    mids = cells[:, 4:].ravel()
-    order = np.argsort(keys, kind="stable")
-    keys, mids = keys[order], mids[order]
-    fe = np.sort(facets[:, [[0, 1], [1, 2], [2, 0]]], axis=2).reshape(-1, 2)
-    fk = fe[:, 0].astype(np.int64) * n + fe[:, 1]
-    pos = np.minimum(np.searchsorted(keys, fk), len(keys) - 1)
-    if not np.array_equal(keys[pos], fk):
-        raise GeometryError("region facets are not faces of the mesh's tetra10 elements")
-    return mids[pos].reshape(-1, 3)
 
 
 def oriented_facets(cells: np.ndarray, facets: np.ndarray) -> np.ndarray:

@@ -10,9 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..part import Cylinder, MassProperties, Part, Region
-from .loads import TET10_EDGES, facet_midnodes
-
-_TET_FACES = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
+from ..topology import TET10_EDGES, boundary_facets, facet_nodes
 
 
 def elevate_to_p2(points: np.ndarray, tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -22,21 +20,6 @@ def elevate_to_p2(points: np.ndarray, tets: np.ndarray) -> tuple[np.ndarray, np.
     mids = 0.5 * (points[uniq[:, 0]] + points[uniq[:, 1]])
     t10 = np.hstack([tets, len(points) + inv.reshape(len(tets), 6)])
     return np.vstack([points, mids]), t10
-
-
-def boundary_facets(cells: np.ndarray) -> np.ndarray:
-    """Corner triangles (n, 3) that belong to exactly one tetrahedron."""
-    f = np.sort(cells[:, :4][:, _TET_FACES], axis=2).reshape(-1, 3)
-    uniq, counts = np.unique(f, axis=0, return_counts=True)
-    return uniq[counts == 1]
-
-
-def facet_nodes(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
-    """All nodes (corners and, for tetra10, mid-edge nodes) of corner triangles."""
-    nodes = [facets.ravel()]
-    if cells.shape[1] == 10:
-        nodes.append(facet_midnodes(facets, cells).ravel())
-    return np.unique(np.concatenate(nodes))
 
 
 def region(name: str, points, cells, facets, select, cylinder=None) -> Region:

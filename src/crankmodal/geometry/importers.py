@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import GeometryError, InputFileError
 from ..part import Cylinder, Part, Region
-from .massprops import _TET10_EDGES
+from ..topology import boundary_facets, facet_nodes
 from .mesh import MeshSettings
 from .regions import RegionSpec
 
@@ -77,32 +77,8 @@ def import_cad(path, specs: list, settings: MeshSettings) -> Part:
                 params={"file": str(path), "mesh": settings.to_dict()}, cad_mass=cad, quality=stats)
 
 
-def boundary_facets(cells: np.ndarray) -> np.ndarray:
-    """Corner triangles (n, 3) on the boundary of a tetrahedral mesh (faces used once)."""
-    c = cells[:, :4]
-    faces = np.concatenate([c[:, [0, 2, 1]], c[:, [0, 1, 3]], c[:, [0, 3, 2]], c[:, [1, 2, 3]]])
-    key = np.sort(faces, axis=1)
-    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
-    return faces[first[counts == 1]]
-
-
-def _facet_nodes(cells: np.ndarray, facets: np.ndarray) -> np.ndarray:
-    """All nodes (mid-side included) on the given corner facets of a tetra/tetra10 mesh."""
-    nodes = set(np.unique(facets).tolist())
-    if cells.shape[1] == 10:
-        on = np.isin(cells[:, :4], facets)
-        fkeys = {tuple(sorted(e)) for f in facets.tolist() for e in ((f[0], f[1]), (f[1], f[2]), (f[0], f[2]))}
-        for k, (i, j) in enumerate(_TET10_EDGES):
-            both = on[:, i] & on[:, j]
-            if np.any(both):
-                ekey = np.sort(np.column_stack([cells[both, i], cells[both, j]]), axis=1)
-                mids = cells[both, 4 + k]
-                nodes.update(int(m) for (a, b), m in zip(ekey, mids) if (a, b) in fkeys)
-    return np.array(sorted(nodes), dtype=np.int64)
-
-
 def _region(name: str, cells, facets, cylinder=None) -> Region:
-    return Region(name=name, facets=facets, nodes=_facet_nodes(cells, facets), cylinder=cylinder)
+    return Region(name=name, facets=facets, nodes=facet_nodes(facets, cells), cylinder=cylinder)
 
 
 def _geometric_regions(points, cells, specs: list) -> dict:

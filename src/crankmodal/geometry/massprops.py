@@ -5,9 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..part import MassProperties
-
-#: meshio/VTK tetra10 edges (after the four corners).
-_TET10_EDGES = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
+from ..topology import TET10_EDGES
 
 
 def cad_mass_properties(gmsh, volumes: list) -> MassProperties:
@@ -47,7 +45,7 @@ def _shape(pts: np.ndarray, n_nodes: int):
         return lam, np.broadcast_to(dlam, (len(pts), 4, 3))
     N = [lam[:, i] * (2 * lam[:, i] - 1) for i in range(4)]
     dN = [(4 * lam[:, i] - 1)[:, None] * dlam[i] for i in range(4)]
-    for i, j in _TET10_EDGES:
+    for i, j in TET10_EDGES:
         N.append(4 * lam[:, i] * lam[:, j])
         dN.append(4 * (lam[:, j][:, None] * dlam[i] + lam[:, i][:, None] * dlam[j]))
     return np.column_stack(N), np.stack(dN, axis=1)

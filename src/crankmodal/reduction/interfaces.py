@@ -25,7 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SceneError
-from ..fem.loads import facet_midnodes, facet_quadrature
+from ..fem.loads import facet_quadrature
+from ..topology import facet_midnodes
 
 KINDS = ("rigid", "distributing")
 
