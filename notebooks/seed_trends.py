@@ -32,6 +32,7 @@ from crankmodal.dynamics.signals import (
     force_direction,
     impact_statistics,
     order_amplitudes,
+    window_peaks,
 )
 from crankmodal.dynamics.simulate import integrate
 from crankmodal.plotting import pyplot
@@ -46,12 +47,13 @@ T_START = time.perf_counter()
 RESULTS = {}
 
 
-def run_scene(scene, overrides, ideal=False):
-    """Mechanism and history of a scene with overrides (output every 0.5 deg of crank)."""
+def run_scene(scene, overrides, ideal=False, dt=None):
+    """Mechanism and history of a scene with overrides (output every ``dt`` s, default 0.5 deg
+    of crank)."""
     params = check(load_scene(ROOT / "scenes" / scene, overrides))
     p = params["dynamics"]
     mech = build_mechanism(p, params.get("mechanism"))
-    h = simulate(mech, p["end_time"], 1.0 / (720 * mech.revolution_hz),
+    h = simulate(mech, p["end_time"], dt or 1.0 / (720 * mech.revolution_hz),
                  solver_settings(p, 60 * mech.revolution_hz), ideal=ideal)
     return mech, h
 
@@ -173,8 +175,6 @@ plt.close(fig)
 # approach velocity and median peak contact force.
 
 # %%
-from crankmodal.dynamics.signals import window_peaks
-
 SPAN, DT_SPEED = 0.405, 2.0e-5
 
 
@@ -183,10 +183,7 @@ def four_star_speed(rpm, friction="coulomb", c=1.0e-4):
     ov = [f"dynamics.end_time={WINDOW_START + SPAN}", "dynamics.ramp_time=0.1",
           f"dynamics.speed_rpm={rpm}", f"dynamics.friction.law='{friction}'",
           f"dynamics.clearances=[{{joint='big_end_1', clearance={c}, journal_radius=0.0225}}]"]
-    params = check(load_scene(ROOT / "scenes" / "four_star_dynamics.toml", ov))
-    p = params["dynamics"]
-    mech = build_mechanism(p, params.get("mechanism"))
-    h = simulate(mech, p["end_time"], DT_SPEED, solver_settings(p, 60 * mech.revolution_hz))
+    _, h = run_scene("four_star_dynamics.toml", ov, dt=DT_SPEED)
     sel = (h.t >= WINDOW_START - 1e-12) & (h.t <= WINDOW_START + SPAN + 1e-12)
     t, a = h.t[sel], h.piston_acceleration[sel, 0]
     ons = np.array([o for o in h.onsets["big_end_1"]
@@ -320,12 +317,7 @@ NEAR = {"92": (40.0, 140.0), "322": (250.0, 359.5)}   # crank-angle windows of t
 
 def loom_ideal(overrides=()):
     """Ideal-joint (zero-clearance) history of the loom scene over one revolution, 0.5 deg."""
-    params = check(load_scene(LOOM, ["dynamics.end_time=0.1333333333333333", *overrides]))
-    p = params["dynamics"]
-    mech = build_mechanism(p)
-    t_end = 1.0 / mech.revolution_hz
-    h = simulate(mech, t_end, t_end / 720, solver_settings(p, 60 * mech.revolution_hz), ideal=True)
-    return mech, h
+    return run_scene(LOOM.name, ["dynamics.end_time=0.1333333333333333", *overrides], ideal=True)
 
 
 def crank_deg_of(h, seed_frame=True):

@@ -8,7 +8,13 @@ import pytest
 from crankmodal.dynamics.analysis import simulate
 from crankmodal.dynamics.build import build_mechanism, solver_settings
 from crankmodal.dynamics.reynolds import steady_bearing
-from crankmodal.dynamics.signals import force_direction, impact_statistics
+from crankmodal.dynamics.signals import (
+    amplitude_spectrum,
+    force_direction,
+    impact_statistics,
+    order_amplitudes,
+    window_peaks,
+)
 from crankmodal.dynamics.simulate import integrate
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
@@ -16,11 +22,12 @@ from crankmodal.scene import load_scene
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 
 
-def _run(scene, overrides):
+def _run(scene, overrides, dt=None):
+    """History of a scene with overrides, output every ``dt`` s (default 0.5 deg of crank)."""
     params = check(load_scene(SCENES / scene, overrides))
     p = params["dynamics"]
     mech = build_mechanism(p, params.get("mechanism"))
-    return simulate(mech, p["end_time"], 1.0 / (720 * mech.revolution_hz),
+    return simulate(mech, p["end_time"], dt or 1.0 / (720 * mech.revolution_hz),
                     solver_settings(p, 60 * mech.revolution_hz))
 
 
@@ -57,8 +64,6 @@ def test_seed003_impact_velocity_in_the_worn_big_end_rises_with_wear():
 # revolutions from 0.15 s); numbers of the 5-revolution notebook run in the comments
 
 def _four_star(c, rpm, n_rev=3, friction="coulomb"):
-    from crankmodal.dynamics.signals import order_amplitudes
-
     t0 = 0.15
     h = _run("four_star_dynamics.toml", [
         f"dynamics.end_time={t0 + n_rev * 60.0 / rpm}", "dynamics.ramp_time=0.1",
@@ -89,21 +94,16 @@ def test_seed000_fig26_clearance_broadens_the_main_bearing_spectrum_and_fig24_ra
 
 def _four_star_record(rpm, friction="coulomb", span=0.405, dt=2e-5):
     """Equal-length, equally sampled record (a 0.5-deg output step is 563 us at 148 rpm)."""
-    from crankmodal.dynamics.signals import window_peaks
-
     t0 = 0.15
-    params = check(load_scene(SCENES / "four_star_dynamics.toml", [
+    h = _run("four_star_dynamics.toml", [
         f"dynamics.end_time={t0 + span}", "dynamics.ramp_time=0.1", f"dynamics.speed_rpm={rpm}",
         f"dynamics.friction.law='{friction}'",
-        "dynamics.clearances=[{joint='big_end_1', clearance=1e-4, journal_radius=0.0225}]"]))
-    p = params["dynamics"]
-    mech = build_mechanism(p, params.get("mechanism"))
-    h = simulate(mech, p["end_time"], dt, solver_settings(p, 60 * mech.revolution_hz))
+        "dynamics.clearances=[{joint='big_end_1', clearance=1e-4, journal_radius=0.0225}]"], dt)
     sel = h.t >= t0 - 1e-12
     v = np.array([o[1] for o in h.onsets["big_end_1"] if o[0] >= t0 and o[1] >= 1e-3])
     return {"acc": window_peaks(h.t[sel], h.piston_acceleration[sel, 0], 0.02),
             "impacts_per_s": v.size / span, "v_median": float(np.median(v)), "h": h, "sel": sel,
-            "rev_hz": mech.revolution_hz}
+            "rev_hz": rpm / 60.0}
 
 
 @pytest.mark.slow
@@ -128,8 +128,6 @@ def test_seed000_figs19_20_friction_raises_the_contact_band_and_leaves_the_first
     # contact, sqrt(F / (c m_t)) / 2 pi); 1000-2000 Hz 696 -> 1627 N. The seed's 225 Hz peak
     # that friction suppresses is not reproduced (200-250 Hz: the 9th order, 58 / 54 N, as the
     # ideal model's 58 N): not asserted.
-    from crankmodal.dynamics.signals import amplitude_spectrum
-
     out = {}
     for fr in ("none", "coulomb"):
         x = _four_star_record(1480.0, fr)
