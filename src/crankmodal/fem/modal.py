@@ -242,21 +242,30 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
     MQ = np.empty((n, cap), order="F")  # M Q, kept so each step costs one product with M
     alpha, beta = np.zeros(cap), np.zeros(cap)
 
+    def orthogonalise(v, Mv, j):
+        """v, Mv M-orthogonalised against Q[:, :j] in place; the M-norm left. A second pass only
+        when the first cancelled (Kahan-Parlett: "twice is enough")."""
+        norm = float(np.sqrt(max(v @ Mv, 0.0)))
+        for _ in range(2 if j else 0):
+            c = Q[:, :j].T @ Mv
+            v -= Q[:, :j] @ c
+            Mv -= MQ[:, :j] @ c
+            norm, before = float(np.sqrt(max(v @ Mv, 0.0))), norm
+            if norm > 0.7071 * before:
+                break
+        return norm
+
     def start(j, v):
         """Put v, M-orthogonalised against Q[:, :j], in column j; False if nothing is left."""
+        v = np.array(v, float)
         Mv = M @ v
-        for _ in range(2):
-            if j:
-                c = Q[:, :j].T @ Mv
-                v = v - Q[:, :j] @ c
-                Mv = Mv - MQ[:, :j] @ c
-        nv = float(np.sqrt(max(v @ Mv, 0.0)))
+        nv = orthogonalise(v, Mv, j)
         if not np.isfinite(nv) or nv == 0.0:
             return False
         Q[:, j], MQ[:, j] = v / nv, Mv / nv
         return True
 
-    if not start(0, np.asarray(v0, float)):
+    if not start(0, v0):
         raise NumericalError("modal: the Lanczos start vector is zero or not finite")
     theta = Y = res = None
     steps = 0
@@ -272,15 +281,7 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
         if j:
             w -= beta[j] * Q[:, j - 1]
             Mw -= beta[j] * MQ[:, j - 1]
-        norm = float(np.sqrt(max(w @ Mw, 0.0)))
-        for _ in range(2):  # a second pass when the first cancelled (Kahan-Parlett: "twice is
-            c = Q[:, :j + 1].T @ Mw  # enough")
-            w -= Q[:, :j + 1] @ c
-            Mw -= MQ[:, :j + 1] @ c
-            b, before = float(np.sqrt(max(w @ Mw, 0.0))), norm
-            norm = b
-            if b > 0.7071 * before:
-                break
+        b = orthogonalise(w, Mw, j + 1)
         m = j + 1
         T = np.diag(alpha[:m]) + np.diag(beta[1:m], 1) + np.diag(beta[1:m], -1)
         theta, Y = np.linalg.eigh(T)
