@@ -125,9 +125,9 @@ def test_seed000_fig25_higher_speed_gives_more_frequent_and_harder_impacts():
 def test_seed000_figs19_20_friction_raises_the_contact_band_and_leaves_the_first_order():
     # 1480 rpm, 0.10 mm, 10 revolutions: first order 4551 / 4553 N (ideal 4550); 500-1000 Hz
     # RMS 949 -> 1517 N (peak 307 N at 868 Hz -> 673 N at 898 Hz: the rod rocking on the
-    # contact, sqrt(F / (c m_t)) / 2 pi); 1000-2000 Hz 696 -> 1627 N. The seed's 225 Hz peak
-    # that friction suppresses is not reproduced (200-250 Hz: the 9th order, 58 / 54 N, as the
-    # ideal model's 58 N): not asserted.
+    # contact, sqrt(F / (c m_t)) / 2 pi); 1000-2000 Hz 696 -> 1627 N. Over independent 10- and
+    # 20-revolution records (other speed ramps) the smallest 500-1000 Hz ratio was 1.16: the
+    # margins below are 1.1 and 1.3. (The 9th-order line near the seed's 225 Hz: next test.)
     out = {}
     for fr in ("none", "coulomb"):
         x = _four_star_record(1480.0, fr)
@@ -138,7 +138,54 @@ def test_seed000_figs19_20_friction_raises_the_contact_band_and_leaves_the_first
                for lo, hi in ((500.0, 1000.0), (1000.0, 2000.0))]
         out[fr] = (float(A[np.argmin(np.abs(s.order - 1.0))]), *rms)
     assert out["coulomb"][0] == pytest.approx(out["none"][0], rel=0.01)
-    assert out["coulomb"][1] > 1.3 * out["none"][1] and out["coulomb"][2] > 1.5 * out["none"][2]
+    assert out["coulomb"][1] > 1.1 * out["none"][1] and out["coulomb"][2] > 1.3 * out["none"][2]
+
+
+def _four_star_y_lines(friction, n_rev=20, ideal=False):
+    """Main-bearing y force (along cylinder 1) over ``n_rev`` revolutions from 0.15 s at
+    1480 rpm, 0.10 mm: order lines 7 and 9 and the 300-500 Hz content between the order lines."""
+    t0, rev_hz = 0.15, 1480.0 / 60.0
+    ov = [f"dynamics.end_time={t0 + n_rev / rev_hz}", "dynamics.ramp_time=0.1",
+          "dynamics.speed_rpm=1480.0", f"dynamics.friction.law='{friction}'",
+          "dynamics.clearances=[{joint='big_end_1', clearance=1e-4, journal_radius=0.0225}]"]
+    if ideal:
+        params = check(load_scene(SCENES / "four_star_dynamics.toml", ov))
+        p = params["dynamics"]
+        mech = build_mechanism(p, params.get("mechanism"))
+        h = simulate(mech, p["end_time"], 1.0 / (720 * rev_hz),
+                     solver_settings(p, 60 * rev_hz), ideal=True)
+    else:
+        h = _run("four_star_dynamics.toml", ov)
+    sel = (h.t >= t0 - 1e-9) & (h.t < t0 + n_rev / rev_hz - 1e-9)   # whole revolutions
+    t, fy = h.t[sel], h.main_bearing_force[sel, 1]
+    o7, o9 = order_amplitudes(t, fy, rev_hz, (7, 9))
+    s = amplitude_spectrum(t, fy, rev_hz, window="rect")   # order lines fall on single bins
+    m = ((s.frequency_hz >= 300.0) & (s.frequency_hz < 500.0)
+         & (np.abs(s.order - np.round(s.order)) > 0.5 / n_rev))
+    return {"o7": float(o7), "o9": float(o9),
+            "between_300_500": float(np.sqrt(np.sum(s.amplitude[m] ** 2) / 2.0))}
+
+
+@pytest.mark.slow
+def test_seed000_figs19_20_friction_pulls_the_9th_order_line_back_to_the_ideal_joint_value():
+    # Seed 000: "without friction the peak near 225 Hz is obvious; friction suppresses it and
+    # raises the nearby band". 225 Hz is the 9th order at 1480 rpm (222 Hz). Main-bearing y
+    # force, 0.10 mm, 20 revolutions from 0.15 s, four independent records per case (ramp
+    # 0.1 s twice, 0.08 s, 0.05 s): order 9 ideal 108 N; no friction 148/142/138/143 N;
+    # Coulomb (Table 4) 119/119/122/125 N -- difference 22 +- 5 N, smallest pair 13 N.
+    # Order 7 likewise (ideal 148; 177/170/172/173 -> 160/158/164/156 N). 300-500 Hz between
+    # the lines: 300/419/380/368 -> 548/605/446/461 N (smallest gap 27 N; asserted only as
+    # "not lower"). Not asserted: the x force (order 9: 57 -> 58 N, no effect), and other
+    # clearances (0.15 mm: no effect on order 9).
+    ideal = _four_star_y_lines("coulomb", n_rev=5, ideal=True)
+    none = _four_star_y_lines("none")
+    coul = _four_star_y_lines("coulomb")
+    # the clearance without friction raises the line above the ideal-joint one ...
+    assert none["o9"] > ideal["o9"] + 15.0
+    # ... and Coulomb friction takes most of that back (expected 22 N, spread 5 N)
+    assert coul["o9"] < none["o9"] - 8.0
+    assert coul["o7"] < none["o7"] - 4.0
+    assert coul["between_300_500"] > none["between_300_500"]
 
 
 @pytest.mark.slow
