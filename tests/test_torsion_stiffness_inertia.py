@@ -131,3 +131,142 @@ def test_mesh_slab_inertias_equal_box_formula_with_parallel_axis():
     m = rho * 0.1 * 0.1 * 0.06
     expect = m * (0.1**2 + 0.06**2) / 12 + m * 0.03**2
     np.testing.assert_allclose(out, [expect, expect], rtol=1e-12)
+
+
+def _gmsh_p2_cylinders(R, r, lengths, size):
+    """Coaxial cylinders (bore r, 0 for solid) stacked along z, meshed by gmsh at second order.
+
+    The Part's path: OCC solids fragmented so the mesh conforms at the joints, curved P2 cells,
+    converted to meshio's tetra10 node order by the geometry stage's own ``to_meshio``.
+    """
+    from crankmodal.geometry.mesh import MeshSettings, generate, to_meshio
+    from crankmodal.geometry.session import gmsh_session
+
+    with gmsh_session("test cylinder") as gmsh:
+        occ = gmsh.model.occ
+        z, vols = 0.0, []
+        for length in lengths:
+            vols.append((3, occ.addCylinder(0, 0, z, 0, 0, length, R)))
+            z += length
+        if r > 0:
+            hole = occ.addCylinder(0, 0, -1.0, 0, 0, z + 2.0, r)
+            vols, _ = occ.cut(vols, [(3, hole)])
+        if len(vols) > 1:
+            occ.fragment(vols[:1], vols[1:])
+        occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMin", size)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+        generate(gmsh, MeshSettings(size=size, order=2))
+        mesh, _ = to_meshio(gmsh)
+    assert mesh.cells[0].type == "tetra10"
+    return mesh.points, mesh.cells[0].data
+
+
+def test_mesh_slab_inertias_of_a_curved_p2_cylinder_follow_the_circle():
+    # Solid cylinder R = 50 mm, L = 60 mm about its axis: rho pi L R^4 / 2. gmsh P2 at h = 10 and
+    # 20 mm (R/h = 5, 2.5). Measured: curved -3.5e-6 (h = 10 mm) and -5.5e-5 (20 mm), order 3.96
+    # (3.9-4.0 down to h = 2.5 mm); corner-only (straight-edged) -9.6e-3 and -3.7e-2, order 1.96.
+    from crankmodal.torsion.mesh_inertias import slab_axial_inertias
+
+    rho, R, L = 7850.0, 0.05, 0.06
+    exact = rho * math.pi * L * R**4 / 2
+    err = {}
+    for h in (0.02, 0.01):
+        pts, cells = _gmsh_p2_cylinders(R, 0.0, [L], h)
+        curved = slab_axial_inertias(pts, cells, rho, [], (0, 0, 0), (0, 0, 1)).sum()
+        corner = slab_axial_inertias(pts, cells[:, :4], rho, [], (0, 0, 0), (0, 0, 1)).sum()
+        err[h] = (curved / exact - 1, corner / exact - 1)
+    curved, corner = err[0.01]
+    assert abs(curved) < 1e-5
+    assert abs(curved) * 100 < abs(corner)
+    # geometric convergence: at least third order for the P2 surface, second for straight edges
+    assert math.log2(abs(err[0.02][0] / err[0.01][0])) > 3.0
+    assert math.log2(abs(err[0.02][1] / err[0.01][1])) == pytest.approx(2.0, abs=0.3)
+
+
+def test_mesh_slab_inertias_of_a_curved_p2_hollow_cylinder_per_slab():
+    # Two stacked annuli R = 50 mm, bore r = 25 mm, lengths 20 and 40 mm, meshed conforming at the
+    # joint and cut there: each slab rho pi L_i (R^4 - r^4) / 2. Measured at h = 10 mm: curved
+    # -9.0e-8 and -1.7e-8; corner-only -7.6e-3 and -7.8e-3.
+    from crankmodal.torsion.mesh_inertias import slab_axial_inertias
+
+    rho, R, r, lengths = 7850.0, 0.05, 0.025, [0.02, 0.04]
+    exact = rho * math.pi * np.array(lengths) * (R**4 - r**4) / 2
+    pts, cells = _gmsh_p2_cylinders(R, r, lengths, 0.01)
+    curved = slab_axial_inertias(pts, cells, rho, [lengths[0]], (0, 0, 0), (0, 0, 1))
+    corner = slab_axial_inertias(pts, cells[:, :4], rho, [lengths[0]], (0, 0, 0), (0, 0, 1))
+    np.testing.assert_allclose(curved, exact, rtol=1e-6)
+    assert np.all(np.abs(curved / exact - 1) * 100 < np.abs(corner / exact - 1))
+
+
+def test_mesh_slab_inertias_of_straight_tetra10_equal_the_corner_formula():
+    # Mid-edge nodes exactly at the edge midpoints: the quadratic map is affine, so the degree-7
+    # rule reproduces the closed-form tetra value to rounding (any axis, any cut).
+    from crankmodal.fem.testparts import elevate_to_p2
+    from crankmodal.torsion.mesh_inertias import slab_axial_inertias
+
+    pts, tets = _box_tets((0.0, 0.0, 0.0), (0.2, 0.1, 0.06), 3)
+    pts = pts @ np.array([[1.0, 0.2, 0.1], [-0.3, 1.0, 0.4], [0.2, -0.1, 1.0]])  # sheared box
+    p2, t10 = elevate_to_p2(pts, tets)
+    axis = {"axis_point": (0.01, 0.05, -0.02), "axis_direction": (1.0, 0.3, -0.2)}
+    four = slab_axial_inertias(pts, tets, 7200.0, [0.05, 0.12], **axis)
+    ten = slab_axial_inertias(p2, t10, 7200.0, [0.05, 0.12], **axis)
+    np.testing.assert_allclose(ten, four, rtol=1e-12)
+    # still the box formula on the unsheared box with tetra10 cells
+    pts, tets = _box_tets((0.0, 0.0, 0.0), (0.2, 0.1, 0.06), 4)
+    p2, t10 = elevate_to_p2(pts, tets)
+    m = 7200.0 * 0.1 * 0.1 * 0.06
+    out = slab_axial_inertias(p2, t10, 7200.0, [0.1], (0, 0.05, 0), (1, 0, 0))
+    np.testing.assert_allclose(out, m * (0.1**2 + 0.06**2) / 12 + m * 0.03**2, rtol=1e-12)
+
+
+def test_mesh_slab_inertias_of_curved_tetra10_equal_an_independent_degree7_integration():
+    # Mid-edge nodes moved at random (cells strongly curved, none folded): the P2 map makes the
+    # integrand rho |r_perp|^2 det J of degree 7. Oracle: scikit-fem's own isoparametric P2 mesh
+    # (read from meshio's tetra10) with a functional integrated on a collapsed Gauss rule of
+    # 7^3 points (exact to degree 11). Measured 1e-15; a rule exact to degree 6 only
+    # (scikit-fem's "order 7", 24 points) misses by 1.2e-9.
+    import meshio
+    from skfem import Basis, ElementTetP0, Functional
+    from skfem.io.meshio import from_meshio
+
+    from crankmodal.fem.testparts import elevate_to_p2
+    from crankmodal.torsion.mesh_inertias import slab_axial_inertias
+
+    pts, tets = _box_tets((0.0, 0.0, 0.0), (0.1, 0.1, 0.1), 2)
+    x = pts[tets]
+    negative = np.einsum("ij,ij->i", np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), x[:, 3] - x[:, 0]) < 0
+    tets[negative] = tets[negative][:, [0, 2, 1, 3]]
+    p2, t10 = elevate_to_p2(pts, tets)
+    mids = np.arange(len(pts), len(p2))
+    p2[mids] += np.random.default_rng(7).uniform(-0.004, 0.004, (len(mids), 3))  # edges 50-87 mm
+    a, e = np.array([0.01, 0.15, -0.02]), np.array([0.3, -0.4, 1.0])
+    out = slab_axial_inertias(p2, t10, 7200.0, [], a, e)
+
+    mesh = from_meshio(meshio.Mesh(p2, [("tetra10", t10)]))
+    e = e / np.linalg.norm(e)
+
+    @Functional
+    def r_perp2(w):
+        r = w.x - a[:, None, None]
+        return 7200.0 * (np.sum(r * r, axis=0) - np.einsum("i,i...->...", e, r) ** 2)
+
+    g, gw = np.polynomial.legendre.leggauss(7)
+    g, gw = 0.5 * (g + 1), 0.5 * gw
+    u, v, t = (c.ravel() for c in np.meshgrid(g, g, g, indexing="ij"))
+    wu, wv, wt = (c.ravel() for c in np.meshgrid(gw, gw, gw, indexing="ij"))
+    X = np.array([u * (1 - v) * (1 - t), v * (1 - t), t])      # Duffy map onto the unit tet
+    W = wu * wv * wt * (1 - v) * (1 - t) ** 2
+    expect = r_perp2.assemble(Basis(mesh, ElementTetP0(), quadrature=(X, W)))
+    np.testing.assert_allclose(out, [expect], rtol=1e-12)
+
+
+def test_mesh_slab_inertias_reject_a_folded_tetra10_cell():
+    from crankmodal.errors import NumericalError
+    from crankmodal.fem.testparts import elevate_to_p2
+    from crankmodal.torsion.mesh_inertias import slab_axial_inertias
+
+    pts, t10 = elevate_to_p2(np.vstack([np.zeros(3), np.eye(3)]), np.array([[0, 1, 2, 3]]))
+    pts[t10[0, 4]] = [0.05, 0.0, 0.0]  # mid-node of edge 0-1 slid past the quarter point: det J < 0 by 0
+    with pytest.raises(NumericalError, match="fold"):
+        slab_axial_inertias(pts, t10, 1.0, [])

@@ -26,57 +26,111 @@ def cad_mass_properties(gmsh, volumes: list) -> MassProperties:
     return MassProperties(volume=float(total), centroid=c, inertia_per_density=inertia)
 
 
-def _tet_rule(n: int = 5):
-    """Collapsed Gauss rule on the unit tetrahedron: points (m, 3) and weights (m,), exact to degree 2n-3."""
-    x, w = np.polynomial.legendre.leggauss(n)
-    x, w = 0.5 * (x + 1), 0.5 * w
-    a, b, c = (g.ravel() for g in np.meshgrid(x, x, x, indexing="ij"))
-    wa, wb, wc = (g.ravel() for g in np.meshgrid(w, w, w, indexing="ij"))
-    pts = np.column_stack([a * (1 - b) * (1 - c), b * (1 - c), c])
-    return pts, wa * wb * wc * (1 - b) * (1 - c) ** 2
+#: Polynomial degree a tetra10 cell's moments need: det J (3) times x x^T (4) on the P2 map.
+TET10_DEGREE = 7
 
 
-def _shape(pts: np.ndarray, n_nodes: int):
-    """Shape functions (q, n) and their reference gradients (q, n, 3) of tetra/tetra10."""
-    xi, eta, zeta = pts.T
-    lam = np.column_stack([1 - xi - eta - zeta, xi, eta, zeta])
-    dlam = np.array([[-1, -1, -1], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+def _reference(n_nodes: int):
+    """A tetrahedral rule exact for the cell's moments, and the shape functions on it.
+
+    scikit-fem's rule of order ``n`` integrates polynomials up to degree ``n - 1`` exactly:
+    order 3 for a straight tetra (x x^T, degree 2), order 8 (31 points) for tetra10 (degree 7;
+    its 24-point "order 7" rule missed by 1e-6 on a strongly curved cell).
+    Shape functions in meshio's (VTK) node order: corners, then the mid-edge nodes of
+    :data:`crankmodal.topology.TET10_EDGES`.
+
+    Returns
+    -------
+    N : ndarray, shape (q, n_nodes)
+    dN : ndarray, shape (q, n_nodes, 3)
+        Gradients in the reference coordinates.
+    w : ndarray, shape (q,)
+        Weights (summing to 1/6, the reference volume).
+    """
+    from skfem.quadrature import get_quadrature
+    from skfem.refdom import RefTet
+
+    X, w = get_quadrature(RefTet, (TET10_DEGREE if n_nodes == 10 else 2) + 1)
+    lam = np.vstack([1.0 - X.sum(axis=0), X]).T                       # (q, 4) barycentric
+    dlam = np.array([[-1.0, -1.0, -1.0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     if n_nodes == 4:
-        return lam, np.broadcast_to(dlam, (len(pts), 4, 3))
-    N = [lam[:, i] * (2 * lam[:, i] - 1) for i in range(4)]
-    dN = [(4 * lam[:, i] - 1)[:, None] * dlam[i] for i in range(4)]
-    for i, j in TET10_EDGES:
-        N.append(4 * lam[:, i] * lam[:, j])
-        dN.append(4 * (lam[:, j][:, None] * dlam[i] + lam[:, i][:, None] * dlam[j]))
-    return np.column_stack(N), np.stack(dN, axis=1)
+        return lam, np.broadcast_to(dlam, (len(w), 4, 3)), w
+    i, j = TET10_EDGES.T
+    N = np.hstack([lam * (2 * lam - 1), 4 * lam[:, i] * lam[:, j]])
+    dN = np.concatenate([(4 * lam - 1)[:, :, None] * dlam,
+                         4 * (lam[:, j, None] * dlam[i] + lam[:, i, None] * dlam[j])], axis=1)
+    return N, dN, w
+
+
+def cell_moments(points: np.ndarray, cells: np.ndarray, chunk: int = 20000,
+                 oriented: bool = True):
+    """Volume, first and second moments of every tetra/tetra10 cell (meshio node order).
+
+    The isoparametric map of each cell is integrated exactly: a curved (P2) cell's moments are
+    those of its quadratic geometry, not of its straight-edged corners.
+
+    Parameters
+    ----------
+    points : ndarray, shape (n, 3)
+    cells : ndarray of int, shape (c, 4 or 10)
+    chunk : int
+        Cells integrated at a time (about 2 kB each).
+    oriented : bool
+        ``True``: cells must be positively oriented (meshio's convention; a negative Jacobian
+        means a wrong node order). ``False``: each cell may have either orientation (that of its
+        corners); only a Jacobian that changes sign inside a cell is an error.
+
+    Returns
+    -------
+    m0 : ndarray, shape (c,)
+        ``int dV``, m^3.
+    m1 : ndarray, shape (c, 3)
+        ``int x dV``, m^4.
+    m2 : ndarray, shape (c, 3, 3)
+        ``int x x^T dV``, m^5.
+
+    Raises
+    ------
+    ValueError
+        If a cell has neither 4 nor 10 nodes, or a non-positive Jacobian at a quadrature point
+        (inverted, or folded by its mid-edge nodes).
+    """
+    points, cells = np.asarray(points, float), np.asarray(cells)
+    if cells.ndim != 2 or cells.shape[1] not in (4, 10):
+        raise ValueError(f"cells: need shape (n, 4) or (n, 10), got {cells.shape}")
+    N, dN, w = _reference(cells.shape[1])
+    m0, m1, m2 = np.empty(len(cells)), np.empty((len(cells), 3)), np.empty((len(cells), 3, 3))
+    for s in range(0, len(cells), chunk):
+        X = points[cells[s:s + chunk]]                                      # (e, n, 3)
+        J = np.einsum("qnk,enj->eqjk", dN, X, optimize=True)                # dx_j / dxi_k
+        det = np.linalg.det(J)
+        if not oriented:
+            c = X[:, :4]
+            det *= np.sign(np.einsum("ej,ej->e", np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]),
+                                     c[:, 3] - c[:, 0]))[:, None]
+        bad = np.any(det <= 0, axis=1)
+        if np.any(bad):
+            raise ValueError(f"{int(bad.sum())} elements have a non-positive Jacobian "
+                             "(inverted, or folded by their mid-edge nodes)")
+        dv = det * w                                                        # (e, q)
+        x = np.einsum("qn,enj->eqj", N, X, optimize=True)                   # (e, q, 3)
+        m0[s:s + chunk] = dv.sum(axis=1)
+        m1[s:s + chunk] = np.einsum("eq,eqj->ej", dv, x)
+        m2[s:s + chunk] = np.einsum("eq,eqi,eqj->eij", dv, x, x)
+    return m0, m1, m2
 
 
 def mesh_mass_properties(points: np.ndarray, cells: np.ndarray, chunk: int = 20000) -> MassProperties:
     """Mass properties per density integrated over a tetra/tetra10 mesh (meshio node order).
 
-    The isoparametric map of every element is integrated with a collapsed Gauss rule exact
-    for the integrands: 27 points for tetra (degree 2), 125 for the quadratic geometry of
-    tetra10 (degree 7).
+    Sums :func:`cell_moments` (exact for each cell's isoparametric map).
 
     Raises
     ------
     ValueError
         If an element has a non-positive Jacobian at a quadrature point.
     """
-    pts, w = _tet_rule(5 if cells.shape[1] == 10 else 3)
-    N, dN = _shape(pts, cells.shape[1])
-    m0, m1, m2 = 0.0, np.zeros(3), np.zeros((3, 3))
-    for s in range(0, len(cells), chunk):
-        X = points[cells[s:s + chunk]]                      # (e, n, 3)
-        J = np.einsum("qnk,enj->eqjk", dN, X, optimize=True)                # (e, q, 3, 3): dx_j/dxi_k
-        det = np.linalg.det(J)
-        if np.any(det <= 0):
-            raise ValueError("mesh has elements with non-positive Jacobian")
-        dv = det * w                                         # (e, q)
-        x = np.einsum("qn,enj->eqj", N, X, optimize=True)                   # (e, q, 3)
-        m0 += dv.sum()
-        m1 += np.einsum("eq,eqj->j", dv, x)
-        m2 += np.einsum("eq,eqi,eqj->ij", dv, x, x)
+    m0, m1, m2 = (m.sum(axis=0) for m in cell_moments(points, cells, chunk))
     c = m1 / m0
     second = m2 - m0 * np.outer(c, c)                        # centroidal second moments
     inertia = np.trace(second) * np.eye(3) - second
