@@ -32,8 +32,8 @@ ROOT = Path(__file__).resolve().parent.parent
 def slider_crank(clearance=1e-4, rpm=3000.0, stiffness=1e10, method="RK45"):
     cyl = Cylinder(axis_angle=0.0, rod_length=0.14, rod_mass=0.9, rod_inertia=3.1e-3,
                    rod_com=0.042, piston_mass=0.75, gas_force=lambda a: 2000 + 1500 * np.cos(a))
-    contact = dict(law="impact", law_params=dict(stiffness=stiffness, exponent=1.5, damping=300.0,
-                                                 penetration=1e-4))
+    contact = {"law": "impact", "law_params": {"stiffness": stiffness, "exponent": 1.5,
+                                               "damping": 300.0, "penetration": 1e-4}}
     return crank_train(0.035, [cyl], rpm, crank_mass=2.0, crank_inertia=0.01,
                        clearances={"big_end_1": {"clearance": clearance, "journal_radius": 0.02}},
                        contact_kw=contact)

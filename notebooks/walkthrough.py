@@ -13,7 +13,6 @@ import numpy as np
 
 # %% [markdown]
 # ## 1. A torsional chain: exact eigen solution, Holzer and the two-rotor closed form
-
 # %%
 from crankmodal.torsion import TorsionalChain, exact_modes, holzer, two_rotor
 

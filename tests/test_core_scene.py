@@ -4,7 +4,13 @@ import pytest
 
 from crankmodal.errors import InputFileError, SceneError
 from crankmodal.runner import plan
-from crankmodal.scene import apply_override, deep_merge, load_scene, parse_value, scene_from_dict
+from crankmodal.scene import (
+    apply_override,
+    deep_merge,
+    load_scene,
+    parse_value,
+    scene_from_dict,
+)
 
 
 def test_override_values_are_parsed_as_toml():

@@ -82,7 +82,7 @@ def test_hertz_impact_is_elastic_and_lasts_the_hertz_contact_time():
 
 def test_impact_law_damping_ramp_is_continuous_and_dissipative():
     # ADAMS IMPACT: no damping force at first touch (STEP starts at 0), full damping beyond d_max.
-    p = dict(K=1e8, n=1.5, c_max=100.0, d_max=1e-4)
+    p = {"K": 1e8, "n": 1.5, "c_max": 100.0, "d_max": 1e-4}
     assert contact.impact(1e-12, 1.0, **p) == pytest.approx(0.0, abs=1e-6)
     deep = contact.impact(2e-4, 1.0, **p)
     assert deep == pytest.approx(1e8 * 2e-4**1.5 + 100.0)

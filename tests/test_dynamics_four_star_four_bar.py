@@ -50,7 +50,7 @@ def test_four_star_first_order_force_rotates_with_constant_magnitude(star_ideal)
 
 
 def test_four_star_row_offsets_make_a_moment_about_the_crank_centre(star_ideal):
-    m, h = star_ideal
+    _, h = star_ideal
     # joint_forces[big_end_i] is the force of the crank on rod i; the crank takes its reaction
     # at (0, 0, z_i): M = sum_i (0, 0, z_i) x (-f_i), in-plane components (cross product taken
     # with numpy, not the hand-expanded formula of history.record)
@@ -62,9 +62,9 @@ def test_four_star_row_offsets_make_a_moment_about_the_crank_centre(star_ideal):
 
 
 # ----------------------------------------------------------------------------------- four-bar
-LOOM = dict(crank_length=0.035, coupler_length=0.075, rocker_length=0.145,
-            rocker_pivot=(0.008, 0.1598), masses=(35.8, 2.27, 10.42),
-            inertias=(0.0155, 0.0114, 0.0528), extra_rocker_inertia=0.3728, speed_rpm=450.0)
+LOOM = {"crank_length": 0.035, "coupler_length": 0.075, "rocker_length": 0.145,
+        "rocker_pivot": (0.008, 0.1598), "masses": (35.8, 2.27, 10.42),
+        "inertias": (0.0155, 0.0114, 0.0528), "extra_rocker_inertia": 0.3728, "speed_rpm": 450.0}
 
 
 def _loom_positions(th):
@@ -84,7 +84,7 @@ def _loom_positions(th):
 def _loom_kinetic_energy(th, w, h=1e-5):
     """KE at crank speed w from finite-difference velocities of the closed-form positions."""
     D = np.array(LOOM["rocker_pivot"])
-    m1, m2, m3 = LOOM["masses"]
+    _, m2, m3 = LOOM["masses"]  # the crank's centre of mass is on its pivot A: no m1 v^2 term
     I1, I2, I3 = LOOM["inertias"]
     I3 += LOOM["extra_rocker_inertia"]
 
@@ -114,8 +114,8 @@ def test_loom_coupler_pin_clearance_orbit_stays_near_the_clearance_circle():
     from crankmodal.dynamics.contact import cylinder_stiffness
 
     K = float(cylinder_stiffness(0.02, 0.020021, 2.1e11, 0.3, 2.1e11, 0.3))
-    contact = dict(law="lankarani_nikravesh",
-                   law_params=dict(stiffness=K, exponent=1.5, restitution=0.7))
+    contact = {"law": "lankarani_nikravesh",
+               "law_params": {"stiffness": K, "exponent": 1.5, "restitution": 0.7}}
     m = four_bar(**LOOM, clearances={"C": {"clearance": 2.1e-5, "journal_radius": 0.02}},
                  contact_kw=contact)
     T = 0.5 * 60.0 / LOOM["speed_rpm"]

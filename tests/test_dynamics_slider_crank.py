@@ -56,7 +56,7 @@ def _newton_euler(th):
     # rod: M2 a2 = Fb + Fs ; I2 phidd = sb x Fb + ss x Fs
     A = np.array([[1, 0, 0], [0, 1, 1], [-sb[1], sb[0], ss[0]]], float)
     rhs = np.array([M2 * a2[0] - fs_x, M2 * a2[1], I2 * phidd - (-ss[1] * fs_x)])
-    fbx, fby, fsy = np.linalg.solve(A, rhs)
+    fbx, fby, _fsy = np.linalg.solve(A, rhs)  # the piston's side force is not compared
     fb = np.array([fbx, fby])
     main = -fb - M1 * a1          # force of the crank on the ground
     ke = 0.5 * (M1 * v[0:2] @ v[0:2] + (I1) * W**2 + M2 * v[2:4] @ v[2:4] + I2 * v[4] ** 2
@@ -100,8 +100,8 @@ def test_ideal_slider_crank_piston_acceleration_equals_closed_form(ideal_history
 def test_clearance_to_zero_converges_to_the_ideal_joint_solution():
     # Second revolution (start-up transient gone); impact law, steel-like stiffness.
     T = 2 * 60.0 / RPM
-    contact = dict(law="impact", law_params=dict(stiffness=1e10, exponent=1.5, damping=2000.0,
-                                                 penetration=1e-6))
+    contact = {"law": "impact", "law_params": {"stiffness": 1e10, "exponent": 1.5,
+                                               "damping": 2000.0, "penetration": 1e-6}}
     errs = []
     ideal = None
     for c in (1e-4, 1e-5, 1e-6):
@@ -122,10 +122,11 @@ def test_clearance_to_zero_converges_to_the_ideal_joint_solution():
 @pytest.mark.parametrize("friction", ["coulomb", "ambrosio"])
 def test_energy_balance_closes_with_clearance_friction_and_speed_ramp(friction):
     T = 0.03
-    contact = dict(law="lankarani_nikravesh",
-                   law_params=dict(stiffness=1e10, exponent=1.5, restitution=0.5),
-                   friction=friction, friction_params=dict(mu_static=0.1, mu_dynamic=0.08,
-                                                           v_static=1e-4, v_dynamic=1e-2))
+    contact = {"law": "lankarani_nikravesh",
+               "law_params": {"stiffness": 1e10, "exponent": 1.5, "restitution": 0.5},
+               "friction": friction,
+               "friction_params": {"mu_static": 0.1, "mu_dynamic": 0.08, "v_static": 1e-4,
+                                   "v_dynamic": 1e-2}}
     m = _mech({"big_end_1": {"clearance": 1e-4, "journal_radius": 0.02}}, contact,
               ramp_time=0.01, gravity=(0.0, -9.81))
     # LSODA: sliding starts from rest, where the stiction slope makes the problem stiff
@@ -137,8 +138,8 @@ def test_energy_balance_closes_with_clearance_friction_and_speed_ramp(friction):
 
 
 def test_offset_slider_crank_with_clearance_records_impacts_with_positive_velocities():
-    contact = dict(law="impact", law_params=dict(stiffness=1e10, exponent=1.5, damping=300.0,
-                                                 penetration=1e-4))
+    contact = {"law": "impact", "law_params": {"stiffness": 1e10, "exponent": 1.5,
+                                               "damping": 300.0, "penetration": 1e-4}}
     m = _mech({"big_end_1": {"clearance": 2e-4, "journal_radius": 0.02},
                "small_end_1": {"clearance": 1e-4, "journal_radius": 0.01}}, contact)
     h = simulate(m, 0.02, 0.02 / 400)

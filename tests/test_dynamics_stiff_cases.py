@@ -13,11 +13,11 @@ ENERGY_TOL = 1e-3
 def _run(K, c, rpm, e, friction, method="LSODA", budget=40000, viscosity=None):
     cyl = Cylinder(axis_angle=0.0, rod_length=0.14, rod_mass=0.9, rod_inertia=3.1e-3, rod_com=0.042,
                    piston_mass=0.75, gas_force=lambda a: 2000.0 + 1500.0 * np.cos(a))
-    contact = dict(law="lankarani_nikravesh",
-                   law_params=dict(stiffness=K, exponent=1.5, restitution=e),
-                   friction="coulomb" if friction else "none",
-                   friction_params=dict(mu_static=0.1, mu_dynamic=0.08, v_static=1e-4,
-                                        v_dynamic=1e-2))
+    contact = {"law": "lankarani_nikravesh",
+               "law_params": {"stiffness": K, "exponent": 1.5, "restitution": e},
+               "friction": "coulomb" if friction else "none",
+               "friction_params": {"mu_static": 0.1, "mu_dynamic": 0.08, "v_static": 1e-4,
+                                   "v_dynamic": 1e-2}}
     m = crank_train(0.035, [cyl], rpm, crank_mass=2.0, crank_inertia=0.01,
                     clearances={"big_end_1": {"clearance": c, "journal_radius": 0.02,
                                               "viscosity": viscosity, "bearing_length": 0.02}},

@@ -10,7 +10,7 @@ def test_demo_writes_results_report_and_plots_for_every_stage(tmp_path):
     env = dict(os.environ, CRANKMODAL_CACHE=str(tmp_path / "cache"), MPLBACKEND="Agg")
     out = tmp_path / "out"
     proc = subprocess.run([sys.executable, "-m", "crankmodal.cli", "demo", "--out", str(out)],
-                          capture_output=True, text=True, env=env, timeout=900)
+                          capture_output=True, text=True, env=env, timeout=900, check=False)
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "scene four_star_compressor" in proc.stdout
 

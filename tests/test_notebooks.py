@@ -17,7 +17,7 @@ NOTEBOOKS = sorted(p for p in (Path(__file__).resolve().parent.parent / "noteboo
 def test_notebook_runs_and_its_checks_hold(script, tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg")
     proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=600)
+                          capture_output=True, text=True, timeout=600, check=False)
     assert proc.returncode == 0, proc.stderr[-3000:]
 
 

@@ -148,5 +148,5 @@ def test_markdown_cells_with_a_bar_keep_the_table_columns():
 
     rep = Report("t")
     rep.table(["section", "summary"], [["[mechanism]", "|F1| 2959 N"]])
-    row = [ln for ln in rep.to_markdown().splitlines() if ln.startswith("| [mechanism]")][0]
+    row = next(ln for ln in rep.to_markdown().splitlines() if ln.startswith("| [mechanism]"))
     assert row.replace("\\|", "").count("|") == 3  # two cells: three unescaped bars

@@ -4,7 +4,13 @@ import numpy as np
 import pytest
 
 from crankmodal.errors import SceneError
-from crankmodal.torsion import TorsionalChain, exact_modes, holzer, reduce_to_two_rotors, two_rotor
+from crankmodal.torsion import (
+    TorsionalChain,
+    exact_modes,
+    holzer,
+    reduce_to_two_rotors,
+    two_rotor,
+)
 from crankmodal.torsion.holzer import holzer_residual
 
 

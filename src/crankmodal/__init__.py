@@ -6,7 +6,8 @@ Heavy dependencies (gmsh, scikit-fem, pyvista) are imported inside the stage tha
 so ``import crankmodal`` stays light.
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
 try:
     __version__ = _version("crankmodal")

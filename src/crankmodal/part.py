@@ -145,11 +145,11 @@ class Part:
 
     @property
     def n_elements(self) -> int:
-        return int(len(self.mesh.cells[0].data))
+        return len(self.mesh.cells[0].data)
 
     @property
     def n_nodes(self) -> int:
-        return int(len(self.mesh.points))
+        return len(self.mesh.points)
 
     def summary(self) -> dict:
         """JSON-able description (no arrays of mesh size)."""
@@ -160,7 +160,7 @@ class Part:
             "n_elements": self.n_elements,
             "n_nodes": self.n_nodes,
             "regions": {
-                k: {"n_facets": int(len(r.facets)), "n_nodes": int(len(r.nodes)),
+                k: {"n_facets": len(r.facets), "n_nodes": len(r.nodes),
                     "area_m2": r.area(self.mesh.points),
                     **({"cylinder": r.cylinder.to_dict()} if r.cylinder else {})}
                 for k, r in self.regions.items()

@@ -81,10 +81,10 @@ def build_mechanism(p, mechanism_params=None):
 
 
 def _common(p, speed_rpm, specs, kw, direction):
-    return dict(speed_rpm=speed_rpm, theta0=np.deg2rad(p["initial_angle_deg"]),
-                ramp_time=p["ramp_time"], drive_torque=p["drive_torque"], clearances=specs,
-                contact_kw=kw, gravity=tuple(p["gravity"]), baumgarte=p["solver"]["baumgarte"],
-                direction=direction)
+    return {"speed_rpm": speed_rpm, "theta0": np.deg2rad(p["initial_angle_deg"]),
+            "ramp_time": p["ramp_time"], "drive_torque": p["drive_torque"], "clearances": specs,
+            "contact_kw": kw, "gravity": tuple(p["gravity"]),
+            "baumgarte": p["solver"]["baumgarte"], "direction": direction}
 
 
 def solver_settings(p, speed_rpm) -> SolverSettings:

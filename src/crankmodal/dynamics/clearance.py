@@ -108,9 +108,9 @@ class ClearanceJoint:
         delta_dot = float(grad @ vrel + dc * vb[2])
         r_b = self.journal_radius + c
         v_slip = float(t @ vrel + self.journal_radius * vj[2] - r_b * vb[2])
-        return dict(e=e, n=n, t=t, grad=grad, dtheta=dc, delta=delta, delta_dot=delta_dot,
-                    v_slip=v_slip, Jj=Jj, Jb=Jb, r_b=r_b, d=d, vrel=vrel,
-                    omega_sum=float(vj[2] + vb[2]))
+        return {"e": e, "n": n, "t": t, "grad": grad, "dtheta": dc, "delta": delta,
+                "delta_dot": delta_dot, "v_slip": v_slip, "Jj": Jj, "Jb": Jb, "r_b": r_b, "d": d,
+                "vrel": vrel, "omega_sum": float(vj[2] + vb[2])}
 
     def bore_clearance(self, phi):
         """Radial clearance (m) of the bore in direction ``phi`` (bearing frame) and its derivative.

@@ -205,8 +205,8 @@ class Multibody:
         sol = np.linalg.solve(K, rhs)
         self._cache = None
         qdd, lam = sol[:n], sol[n:]
-        return dict(qdd=qdd, lam=lam, phi=phi, Cq=Cq, nu=nu, contacts=contacts,
-                    p_loads=p_loads)
+        return {"qdd": qdd, "lam": lam, "phi": phi, "Cq": Cq, "nu": nu, "contacts": contacts,
+                "p_loads": p_loads}
 
     def drive_power(self, lam, Cq, qd):
         """Power of the rheonomic (drive) constraints and of the ideal joints, W."""
