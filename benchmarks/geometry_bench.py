@@ -59,7 +59,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--fidelity", default="full")
     ap.add_argument("--order", type=int, default=2)
-    ap.add_argument("--sizes", type=float, nargs="+", default=[0.012, 0.009, 0.0072])
+    ap.add_argument("--sizes", type=float, nargs="+", default=[0.012, 0.009, 0.0070])
     ap.add_argument("--render", metavar="FOLDER", help="write PNG pictures of the three fidelities instead")
     args = ap.parse_args()
     if args.render:
