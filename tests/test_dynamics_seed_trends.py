@@ -22,13 +22,14 @@ from crankmodal.scene import load_scene
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 
 
-def _run(scene, overrides, dt=None):
-    """History of a scene with overrides, output every ``dt`` s (default 0.5 deg of crank)."""
+def _run(scene, overrides, dt=None, ideal=False):
+    """History of a scene with overrides, output every ``dt`` s (default 0.5 deg of crank);
+    ``ideal``: every clearance joint made ideal."""
     params = check(load_scene(SCENES / scene, overrides))
     p = params["dynamics"]
     mech = build_mechanism(p, params.get("mechanism"))
     return simulate(mech, p["end_time"], dt or 1.0 / (720 * mech.revolution_hz),
-                    solver_settings(p, 60 * mech.revolution_hz))
+                    solver_settings(p, 60 * mech.revolution_hz), ideal=ideal)
 
 
 @pytest.mark.slow
@@ -148,14 +149,7 @@ def _four_star_y_lines(friction, n_rev=20, ideal=False):
     ov = [f"dynamics.end_time={t0 + n_rev / rev_hz}", "dynamics.ramp_time=0.1",
           "dynamics.speed_rpm=1480.0", f"dynamics.friction.law='{friction}'",
           "dynamics.clearances=[{joint='big_end_1', clearance=1e-4, journal_radius=0.0225}]"]
-    if ideal:
-        params = check(load_scene(SCENES / "four_star_dynamics.toml", ov))
-        p = params["dynamics"]
-        mech = build_mechanism(p, params.get("mechanism"))
-        h = simulate(mech, p["end_time"], 1.0 / (720 * rev_hz),
-                     solver_settings(p, 60 * rev_hz), ideal=True)
-    else:
-        h = _run("four_star_dynamics.toml", ov)
+    h = _run("four_star_dynamics.toml", ov, ideal=ideal)
     sel = (h.t >= t0 - 1e-9) & (h.t < t0 + n_rev / rev_hz - 1e-9)   # whole revolutions
     t, fy = h.t[sel], h.main_bearing_force[sel, 1]
     o7, o9 = order_amplitudes(t, fy, rev_hz, (7, 9))

@@ -145,16 +145,18 @@ def generate(gmsh, settings: MeshSettings) -> None:
     if settings.order == 2:
         gmsh.model.mesh.setOrder(2)
         threshold = CURVED_SJ if settings.optimize else 0.01
-        if _min_quality(gmsh, 11, "minSJ") <= threshold:
-            if settings.optimize and not netgen:
-                # better-shaped straight tetrahedra next to the curved faces fold far less
-                gmsh.model.mesh.setOrder(1)
-                gmsh.model.mesh.optimize("Netgen")
-                gmsh.model.mesh.setOrder(2)
-            if _min_quality(gmsh, 11, "minSJ") <= threshold:
-                gmsh.option.setNumber("Mesh.HighOrderThresholdMin", threshold)
-                gmsh.model.mesh.optimize("HighOrder")
-        if _min_quality(gmsh, 11, "minSJ") <= 0:
+        sj = _min_quality(gmsh, 11, "minSJ")
+        if sj <= threshold and settings.optimize and not netgen:
+            # better-shaped straight tetrahedra next to the curved faces fold far less
+            gmsh.model.mesh.setOrder(1)
+            gmsh.model.mesh.optimize("Netgen")
+            gmsh.model.mesh.setOrder(2)
+            sj = _min_quality(gmsh, 11, "minSJ")
+        if sj <= threshold:
+            gmsh.option.setNumber("Mesh.HighOrderThresholdMin", threshold)
+            gmsh.model.mesh.optimize("HighOrder")
+            sj = _min_quality(gmsh, 11, "minSJ")
+        if sj <= 0:
             raise GeometryError("mesh: curved second-order elements fold over at a small feature; "
                                 "use geometry.element_order = 1, a smaller mesh_size or refine")
     gmsh.model.mesh.renumberNodes()
