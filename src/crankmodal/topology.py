@@ -17,16 +17,25 @@ TET_FACES = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
 TET10_EDGES = np.array([[0, 1], [1, 2], [0, 2], [0, 3], [1, 3], [2, 3]])
 
 
-def boundary_facets(cells: np.ndarray) -> np.ndarray:
+#: The corner of a tetrahedron opposite each face of :data:`TET_FACES`.
+TET_FACE_OPPOSITE = np.array([3, 2, 1, 0])
+
+
+def boundary_facets(cells: np.ndarray, opposite: bool = False):
     """Corner triangles (n, 3) on the boundary of a tetra/tetra10 mesh (faces used once).
 
     Each keeps the node order of its element's face: outward for positively oriented elements.
+    With ``opposite``, also the element's fourth corner behind each triangle (n,), which orients
+    the triangle whatever the element's orientation.
     """
     c = np.asarray(cells)[:, :4]
     faces = c[:, TET_FACES].transpose(1, 0, 2).reshape(-1, 3)
     _, first, counts = np.unique(np.sort(faces, axis=1), axis=0, return_index=True,
                                  return_counts=True)
-    return faces[first[counts == 1]]
+    sel = first[counts == 1]
+    if opposite:
+        return faces[sel], c[:, TET_FACE_OPPOSITE].T.ravel()[sel]
+    return faces[sel]
 
 
 def facet_midnodes(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
