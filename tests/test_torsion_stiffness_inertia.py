@@ -200,8 +200,9 @@ def test_mesh_slab_inertias_of_a_curved_p2_hollow_cylinder_per_slab():
 
 
 def test_mesh_slab_inertias_of_straight_tetra10_equal_the_corner_formula():
-    # Mid-edge nodes exactly at the edge midpoints: the quadratic map is affine, so the degree-7
-    # rule reproduces the closed-form tetra value to rounding (any axis, any cut).
+    # Mid-edge nodes exactly at the edge midpoints: the quadratic map is affine, so the P2 map on
+    # the degree-7 rule reproduces the straight tetra (P1 map, degree-2 rule) to rounding (any
+    # axis, any cut); the unsheared box is then checked against its closed form.
     from crankmodal.fem.testparts import elevate_to_p2
     from crankmodal.torsion.mesh_inertias import slab_axial_inertias
 
