@@ -59,3 +59,28 @@ def test_debug_shows_the_traceback(cli, tmp_path):
     proc = cli("--debug", "run", tmp_path / "missing.toml")
     assert proc.returncode != 0
     assert "Traceback" in proc.stderr
+
+
+def test_a_model_too_large_for_the_memory_stops_before_the_factorisation(cli, tmp_path, monkeypatch):
+    import meshio
+    import numpy as np
+
+    from crankmodal.fem.testparts import bar
+
+    part = bar(0.2, 0.02, 0.02, (10, 2, 2), order=1)
+    p, cells = part.mesh.points, part.mesh.cells[0].data.copy()
+    e = p[cells[:, 1:]] - p[cells[:, :1]]
+    flip = np.einsum("ij,ij->i", np.cross(e[:, 0], e[:, 1]), e[:, 2]) < 0
+    cells[flip] = cells[flip][:, [0, 2, 1, 3]]  # positive volumes, as a mesher writes them
+    meshio.write(tmp_path / "bar.vtu", meshio.Mesh(part.mesh.points, [("tetra", cells)]))
+    s = tmp_path / "s.toml"
+    s.write_text('[geometry]\nfile = "bar.vtu"\n[material]\nname = "steel"\n[modal]\nn_modes = 4\n')
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", "1e-6")  # 1 kB
+    proc = cli("run", s, "--out", tmp_path / "o")
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr
+    error = [line for line in proc.stderr.splitlines() if "error" in line]
+    assert len(error) == 1  # the stage progress lines, then one error line
+    for f in ("modal: factorising", "GB", "coarser mesh", "CRANKMODAL_MEMORY_LIMIT"):
+        assert f in error[0], error[0]
+    assert not (tmp_path / "o" / "results.json").exists()

@@ -108,3 +108,36 @@ def test_solver_threads_follow_the_environment_and_a_pardiso_solve_is_exact(monk
     b = rng.standard_normal(n)
     x = solvers.factorize(A, "pardiso").solve(b)
     np.testing.assert_allclose(x, np.linalg.solve(A.toarray(), b), rtol=1e-10, atol=1e-14)
+
+
+def test_available_memory_follows_the_environment_and_the_system(monkeypatch):
+    from crankmodal.errors import SceneError
+    from crankmodal.fem.memory import available_bytes
+
+    monkeypatch.delenv("CRANKMODAL_MEMORY_LIMIT", raising=False)
+    avail = available_bytes()
+    assert avail is None or 0 < avail < 1 << 50
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", "2.5")
+    assert available_bytes() == 2_500_000_000
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", "lots")
+    with pytest.raises(SceneError, match="CRANKMODAL_MEMORY_LIMIT.*'lots'"):
+        available_bytes()
+
+
+def test_a_factor_larger_than_the_memory_is_refused_before_it_is_allocated(monkeypatch):
+    """PARDISO's analysis says what the factor will take; over the limit, a ResourceError with
+    advice instead of the kernel killing the run."""
+    from crankmodal.errors import ResourceError
+
+    model = assembly.assemble(bar(0.2, 0.02, 0.02, (20, 4, 4), order=2), STEEL)
+    fac = solvers.factorize(model.K + model.M, "pardiso")
+    needed = fac.memory_needed  # what it took (analysis estimate), bytes
+    assert 1e6 < needed < 1e9
+    del fac
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", str(0.5 * needed / 1e9))
+    with pytest.raises(ResourceError, match=r"needs [\d.e-]+ GB .* available: use a coarser mesh"):
+        solvers.factorize(model.K + model.M, "pardiso")
+    with pytest.raises(ResourceError, match="^modal: factorising"):
+        modal.solve_modes(model, 4)
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", str(2 * needed / 1e9))
+    assert solvers.factorize(model.K + model.M, "pardiso").memory_needed == needed

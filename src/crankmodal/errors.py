@@ -24,6 +24,11 @@ class GeometryError(CrankmodalError):
     """A parameter set describes an impossible part, or the geometry kernel failed on it."""
 
 
+class ResourceError(CrankmodalError):
+    """The problem needs more of this machine (memory) than it has; the message says how much
+    and what to change. Raised before the allocation, instead of the kernel killing the run."""
+
+
 class NumericalError(CrankmodalError):
     """A computation did not meet its own accuracy checks; the message says what to change."""
 

@@ -38,6 +38,69 @@ def release_free_heap() -> None:
         pass
 
 
+def _read_int(path: str) -> int | None:
+    try:
+        with open(path) as fh:
+            text = fh.read().strip()
+    except OSError:
+        return None
+    return int(text) if text.isdigit() else None
+
+
+def _cgroup_room() -> int | None:
+    """What this process's memory cgroup (a container's limit) still allows, bytes, or None."""
+    try:
+        with open("/proc/self/cgroup") as fh:
+            lines = fh.read().splitlines()
+    except OSError:
+        return None
+    for line in lines:
+        _, controllers, path = line.split(":", 2)
+        if controllers == "":  # cgroup v2
+            pairs = [(f"/sys/fs/cgroup{path}/memory.max", f"/sys/fs/cgroup{path}/memory.current"),
+                     ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current")]
+        elif "memory" in controllers.split(","):  # cgroup v1
+            root = "/sys/fs/cgroup/memory"
+            pairs = [(f"{root}{path}/memory.limit_in_bytes", f"{root}{path}/memory.usage_in_bytes"),
+                     (f"{root}/memory.limit_in_bytes", f"{root}/memory.usage_in_bytes")]
+        else:
+            continue
+        for limit_file, usage_file in pairs:
+            limit, usage = _read_int(limit_file), _read_int(usage_file)
+            if limit is not None and usage is not None and limit < 1 << 60:  # v1: "no limit"
+                return max(limit - usage, 0)
+    return None
+
+
+def available_bytes() -> int | None:
+    """Memory this process can still take, bytes; None where the system does not say.
+
+    ``CRANKMODAL_MEMORY_LIMIT`` (GB) if set; else the smaller of the kernel's ``MemAvailable``
+    and the room left under a container's memory limit (cgroup v1 or v2).
+    """
+    env = os.environ.get("CRANKMODAL_MEMORY_LIMIT", "").strip()
+    if env:
+        try:
+            return int(float(env) * 1e9)
+        except ValueError:
+            from ..errors import SceneError
+
+            raise SceneError(f"CRANKMODAL_MEMORY_LIMIT: must be a number of GB, got {env!r}") from None
+    avail = None
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    avail = int(line.split()[1]) * 1024
+                    break
+    except OSError:
+        pass
+    room = _cgroup_room()
+    if room is not None:
+        avail = room if avail is None else min(avail, room)
+    return avail
+
+
 class PeakMemory:
     """Context manager measuring the peak RSS while it is active.
 

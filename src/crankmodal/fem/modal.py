@@ -431,7 +431,8 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
 
         t0 = time.perf_counter()
         try:
-            fac = factorize_shifted(K, M, sigma, backend, positive_definite=True)
+            fac = factorize_shifted(K, M, sigma, backend, positive_definite=True,
+                                    label="modal: ")
         except np.linalg.LinAlgError as exc:
             raise NumericalError(f"modal: factorising K - σM failed ({exc}); the mesh may have "
                                  f"inverted elements, or an extra mechanism") from None

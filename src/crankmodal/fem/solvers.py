@@ -27,7 +27,7 @@ import os
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import SceneError
+from ..errors import ResourceError, SceneError
 
 BACKENDS = ("auto", "pardiso", "superlu")
 
@@ -110,6 +110,8 @@ class PardisoFactor:
         Symmetric; only its upper triangle is used.
     upper : bool
         ``A`` already is that upper triangle (saves a copy).
+    label : str
+        Prefix of error messages (``"modal: "``).
     positive_definite : bool
         ``True``: Cholesky (mtype 2); ``False``: Bunch-Kaufman LDLᵀ (mtype -2).
     """
@@ -117,7 +119,7 @@ class PardisoFactor:
     name = "pardiso"
 
     def __init__(self, A, positive_definite: bool = True, ordering: int = 2,
-                 upper: bool = False):
+                 upper: bool = False, label: str = ""):
         mkl = _mkl()
         self._lib = mkl.pardiso
         self._set_threads = mkl.MKL_Set_Num_Threads_Local  # C interface: int by value
@@ -148,7 +150,11 @@ class PardisoFactor:
             # variable-block storage of the 3-DOF nodes: METIS orders the compressed graph
             # (analysis 3.6 -> 1.35 s at 303k DOF) and the factor needs 0.3 GB less at its peak
             ip[36] = -80
-        self._call(12, np.zeros((self.n, 1)))
+        self._call(11, np.zeros((self.n, 1)))
+        #: PARDISO's own estimate of the memory the factorisation takes at its peak, bytes
+        self.memory_needed = 1024 * max(int(ip[14]), int(ip[15]) + int(ip[16]))
+        check_memory(self.memory_needed, f"{label}factorising {self.n} unknowns", self._release)
+        self._call(22, np.zeros((self.n, 1)))
         self.factor_nnz = int(self.iparm[17])
         self.n_negative = int(self.iparm[22])
 
@@ -181,12 +187,37 @@ class PardisoFactor:
         b = np.asarray(b, float)
         return self._call(33, b).reshape(b.shape)
 
+    def _release(self):
+        """Free PARDISO's memory (phase -1); the handle is then empty."""
+        if self.pt.any():
+            self._call(-1, np.zeros((self.n, 1)))
+            self.pt[:] = 0
+
     def __del__(self):
         try:
-            if self.pt.any():
-                self._call(-1, np.zeros((self.n, 1)))
+            self._release()
         except Exception:  # noqa: BLE001, S110 - interpreter shutdown: nothing left to free
             pass
+
+
+def check_memory(needed: int, what: str, release=None) -> None:
+    """Raise :class:`ResourceError` before allocating ``needed`` bytes the machine does not have.
+
+    Without this, the kernel kills the run (no message, no results) once the factor outgrows the
+    memory. ``release`` frees what was already allocated (PARDISO's analysis) first.
+    """
+    from .memory import available_bytes
+
+    avail = available_bytes()
+    if avail is None or needed <= avail:
+        return
+    if release is not None:
+        release()
+    raise ResourceError(
+        f"{what} needs {needed / 1e9:.3g} GB (the solver's estimate) but {avail / 1e9:.3g} GB are "
+        f"available: use a coarser mesh (a larger geometry.mesh_size; the factor grows about as "
+        f"DOF^1.5), element_order = 1 for a first look, the simplified fidelity, or a machine with "
+        f"more memory (CRANKMODAL_MEMORY_LIMIT, in GB, sets the available figure)")
 
 
 def upper_triangle(A) -> sp.csr_matrix:
@@ -199,7 +230,7 @@ def upper_triangle(A) -> sp.csr_matrix:
     return sp.csr_matrix((A.data[keep], A.indices[keep], indptr), shape=A.shape)
 
 
-def factorize(A, backend: str = "auto", positive_definite: bool = True):
+def factorize(A, backend: str = "auto", positive_definite: bool = True, label: str = ""):
     """Factorise a symmetric sparse matrix once.
 
     Parameters
@@ -208,6 +239,8 @@ def factorize(A, backend: str = "auto", positive_definite: bool = True):
     backend : {"auto", "pardiso", "superlu"}
     positive_definite : bool
         Whether ``A`` is known to be positive definite (Cholesky is used where possible).
+    label : str
+        Prefix of error messages, e.g. ``"static: "``.
 
     Returns
     -------
@@ -215,11 +248,12 @@ def factorize(A, backend: str = "auto", positive_definite: bool = True):
     """
     name = resolve_backend(backend)
     if name == "pardiso":
-        return PardisoFactor(A, positive_definite=positive_definite)
+        return PardisoFactor(A, positive_definite=positive_definite, label=label)
     return SuperLUFactor(A)
 
 
-def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_definite: bool = True):
+def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_definite: bool = True,
+                      label: str = ""):
     """Factorise ``K - σM`` without keeping the full shifted matrix (PARDISO: upper triangle only).
 
     Saves one matrix of the size of K at the memory peak of a large modal solve.
@@ -235,12 +269,13 @@ def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_defini
         else:
             U = upper_triangle(K)
             U -= sigma * upper_triangle(M)
-        return PardisoFactor(U.tocsr(), positive_definite=positive_definite, upper=True)
+        return PardisoFactor(U.tocsr(), positive_definite=positive_definite, upper=True,
+                             label=label)
     return SuperLUFactor(K - sigma * M)
 
 
 def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
-                        positive_definite: bool = True):
+                        positive_definite: bool = True, label: str = ""):
     """Factorise ``K[idx][:, idx]`` without a full copy of it (PARDISO: upper triangle only).
 
     Parameters
@@ -256,5 +291,5 @@ def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
         raise ValueError("idx must be strictly ascending")
     if resolve_backend(backend) == "pardiso":
         U = upper_triangle(K)[idx][:, idx]
-        return PardisoFactor(U, positive_definite=positive_definite, upper=True)
+        return PardisoFactor(U, positive_definite=positive_definite, upper=True, label=label)
     return SuperLUFactor(sp.csr_matrix(K)[idx][:, idx])

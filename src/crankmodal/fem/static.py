@@ -154,7 +154,7 @@ def solve_static(model: FEModel, mesh, load: np.ndarray, supports: list[Support]
     K = reduce_matrix(model.K, T)
     timings["reduce_s"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    q = factorize(K, backend, positive_definite=True).solve(T.T @ load)
+    q = factorize(K, backend, positive_definite=True, label="static: ").solve(T.T @ load)
     u = T @ q
     timings["solve_s"] = time.perf_counter() - t0
     t0 = time.perf_counter()

@@ -275,7 +275,8 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
 
     t0 = time.perf_counter()
     try:  # K_FF (or K_II), its upper triangle only
-        fac = factorize_submatrix(K, I[free], backend, positive_definite=True)
+        fac = factorize_submatrix(K, I[free], backend, positive_definite=True,
+                                  label="reduction: ")
     except np.linalg.LinAlgError as exc:
         raise NumericalError(f"reduction: factorising the interior stiffness failed ({exc}); "
                              f"the interfaces may not hold the part (a mechanism), or the mesh "
