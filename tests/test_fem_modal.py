@@ -112,6 +112,25 @@ def test_p1_with_nearly_incompressible_material_warns_about_locking():
         assembly.assemble(bar(1.0, 0.1, 0.1, (4, 1, 1), order=1), rubberish)
 
 
+def test_p2_near_incompressible_material_warns_and_fails_loudly_with_advice():
+    """P2 does not lock, but K/G = 2(1+ν)/(3(1−2ν)) ruins K's conditioning as ν → 0.5: the bar
+    converges with a warning at ν = 0.49999 (its bending pair within 0.1 % of ν = 0.4999's) and
+    stops with the cause named at ν = 0.4999999 instead of returning poor modes."""
+    def model(nu):
+        mat = material("steel").__class__(name="x", E=1e7, nu=nu, rho=1000.0)
+        return assembly.assemble(bar(1.0, 0.1, 0.1, (10, 2, 2), order=2), mat)
+
+    f_ref = modal.solve_modes(model(0.4999), 2).frequencies_hz
+    with pytest.warns(assembly.ModelWarning, match=r"nu = 0.49999: the bulk modulus is 5.0e\+04"):
+        near = model(0.49999)
+    np.testing.assert_allclose(modal.solve_modes(near, 2).frequencies_hz, f_ref, rtol=1e-3)
+    with pytest.warns(assembly.ModelWarning):
+        bad = model(0.4999999)
+    with pytest.raises(NumericalError, match=r"ill-conditioned .* nu = 0.4999999 makes the bulk "
+                                             r"modulus 5.0e\+06 .* use nu <= 0.4999"):
+        modal.solve_modes(bad, 4)
+
+
 def test_residual_check_fires_on_a_wrong_eigenvalue(bar_model, free_modes):
     model = bar_model[1]
     lam = (2 * np.pi * free_modes.frequencies_hz) ** 2

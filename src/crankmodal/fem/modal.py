@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import NumericalError, SceneError
-from .assembly import FEModel, mass_and_centre, rigid_body_modes
+from .assembly import NU_ILL_CONDITIONED, FEModel, bulk_to_shear, mass_and_centre, rigid_body_modes
 from .memory import PeakMemory
 from .parallel import RowBlocks
 from .supports import Support, reduce_matrix, reduction
@@ -313,6 +313,16 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
                    converged=done)
 
 
+def stall_advice(model: FEModel) -> str:
+    """What to change when the eigenpairs cannot be made accurate: the material or the mesh."""
+    nu = float(model.material.nu)
+    if nu >= NU_ILL_CONDITIONED:
+        return (f"nu = {nu:.10g} makes the bulk modulus {bulk_to_shear(nu):.1e} times the shear "
+                f"modulus; use nu <= 0.4999 (crankmodal has no mixed u-p elements)")
+    return ("look for flat or needle elements (geometry.optimize = true, a larger "
+            "geometry.refine) or extreme size ratios, or loosen modal.tol")
+
+
 def default_shift(K, M) -> float:
     """A negative shift σ (rad²/s²) well below the lowest elastic eigenvalue, scale-free."""
     d = K.diagonal() / M.diagonal()
@@ -483,11 +493,17 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             steps = min(n - D.shape[1], max(4 * k_run + 40, 60))
             last.clear()  # the floor test compares calls within one run
             out = lanczos(apply, M, v0, k_run, LANCZOS_TOL, steps, fresh=fresh, accept=accept)
+            if not out.converged and "r" in last:  # the Lanczos estimates converged, the pairs not
+                raise NumericalError(
+                    f"modal: the eigen-residuals ‖Kx − λMx‖/‖Kx‖ stall at {last['r'].max():.1e} "
+                    f"> tol = {tol:.0e}: K is too ill-conditioned for double precision — "
+                    + stall_advice(model))
             if not out.converged:
                 raise NumericalError(
                     f"modal: {k_run} modes did not converge in {out.steps} Lanczos steps "
                     f"(largest relative residual {np.max(out.residuals / np.abs(out.theta)):.1e});"
-                    f" check the mesh for loose or degenerate elements, or ask for fewer modes")
+                    + (" " + stall_advice(model) if model.material.nu >= NU_ILL_CONDITIONED else
+                       " check the mesh for loose or degenerate elements, or ask for fewer modes"))
             return out
 
         # one BLAS thread for the small dense work of the loop (two were 5-7x slower); PARDISO
