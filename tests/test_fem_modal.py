@@ -249,6 +249,22 @@ def test_lanczos_matches_a_dense_generalised_eigensolver():
     assert np.linalg.norm(r, axis=0).max() < 1e-8 * np.abs(K).max()
 
 
+def test_lanczos_without_the_m_basis_gives_the_same_pairs():
+    """keep_mq=False keeps two columns of M Q and forms M w again after reorthogonalising."""
+    K, M, (lam_ref, _) = _pencil()
+    sigma = -1.0
+    S = np.linalg.inv((K - sigma * M).toarray())
+    np.testing.assert_allclose(np.sort(sigma + 1 / modal.lanczos(
+        lambda b: S @ b, M, np.ones(K.shape[0]), 5, 1e-12, 59, keep_mq=False).theta),
+        lam_ref[:5], rtol=1e-10)
+    full = modal.lanczos(lambda b: S @ b, M, np.ones(K.shape[0]), 5, 1e-12, 59)
+    lean = modal.lanczos(lambda b: S @ b, M, np.ones(K.shape[0]), 5, 1e-12, 59, keep_mq=False)
+    assert lean.converged and lean.steps == full.steps
+    np.testing.assert_allclose(lean.theta, full.theta, rtol=1e-12)
+    np.testing.assert_allclose(np.abs(lean.vectors), np.abs(full.vectors), atol=1e-9)
+    np.testing.assert_allclose(lean.m_vectors, M @ lean.vectors, atol=1e-12)
+
+
 def test_lanczos_restarts_when_the_krylov_space_closes_and_accept_can_ask_for_more():
     import scipy.sparse as sp
 

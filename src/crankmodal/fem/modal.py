@@ -199,7 +199,7 @@ class Lanczos:
 
 
 def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
-            fresh=None, accept=None) -> Lanczos:
+            fresh=None, accept=None, keep_mq: bool = True) -> Lanczos:
     """Largest eigenpairs of the M-self-adjoint operator ``A x = apply(M x)``.
 
     Lanczos in the M-inner product with full reorthogonalisation (twice, against every basis
@@ -231,6 +231,10 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
         continues the iteration. The estimate bounds the residual of the operator, not
         ``‖Kx − λMx‖`` (which weighs the residual's stiff part: 3e4 times larger for a clamped
         beam), so the modal solve checks the pencil's residuals here.
+    keep_mq : bool
+        Keep ``M Q`` beside the basis (one product with M per step). ``False`` keeps only the
+        last two columns of it and forms ``M w`` again after each reorthogonalisation pass: half
+        the memory of a long run (60 fixed-interface modes: 150 steps) for one more product.
 
     Returns
     -------
@@ -243,7 +247,12 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
     cap = max_steps + 1
     # column-major: a column is contiguous, and the pages of columns never reached stay unmapped
     Q = np.empty((n, cap), order="F")
-    MQ = np.empty((n, cap), order="F")  # M Q, kept so each step costs one product with M
+    # M Q, kept so each step costs one product with M; or only its last two columns
+    MQ = np.empty((n, cap if keep_mq else 2), order="F")
+
+    def mq(j):
+        return MQ[:, j] if keep_mq else MQ[:, j % 2]
+
     alpha, beta = np.zeros(cap), np.zeros(cap)
 
     def orthogonalise(v, Mv, j):
@@ -253,7 +262,10 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
         for _ in range(2 if j else 0):
             c = Q[:, :j].T @ Mv
             gemv(-1.0, Q[:, :j], c, beta=1.0, y=v, overwrite_y=True)
-            gemv(-1.0, MQ[:, :j], c, beta=1.0, y=Mv, overwrite_y=True)
+            if keep_mq:
+                gemv(-1.0, MQ[:, :j], c, beta=1.0, y=Mv, overwrite_y=True)
+            else:
+                Mv[:] = M @ v
             norm, before = float(np.sqrt(max(v @ Mv, 0.0))), norm
             if norm > 0.7071 * before:
                 break
@@ -266,7 +278,7 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
         nv = orthogonalise(v, Mv, j)
         if not np.isfinite(nv) or nv == 0.0:
             return False
-        Q[:, j], MQ[:, j] = v / nv, Mv / nv
+        Q[:, j], mq(j)[:] = v / nv, Mv / nv
         return True
 
     if not start(0, v0):
@@ -274,17 +286,17 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
     theta = Y = res = None
     steps = 0
     for j in range(max_steps):
-        w = np.array(apply(MQ[:, j]), float)  # own copy: updated in place below
+        w = np.array(apply(mq(j)), float)  # own copy: updated in place below
         steps += 1
         Mw = np.array(M @ w, float)
         alpha[j] = float(Q[:, j] @ Mw)
         # the three-term recurrence first (two vectors), then full reorthogonalisation, which
         # then only removes rounding: a second pass is rarely needed (each pass reads the basis)
         axpy(Q[:, j], w, a=-alpha[j])  # in place: w, Mw are this step's own arrays
-        axpy(MQ[:, j], Mw, a=-alpha[j])
+        axpy(mq(j), Mw, a=-alpha[j])
         if j:
             axpy(Q[:, j - 1], w, a=-beta[j])
-            axpy(MQ[:, j - 1], Mw, a=-beta[j])
+            axpy(mq(j - 1), Mw, a=-beta[j])
         b = orthogonalise(w, Mw, j + 1)
         m = j + 1
         T = np.diag(alpha[:m]) + np.diag(beta[1:m], 1) + np.diag(beta[1:m], -1)
@@ -295,20 +307,22 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
         done = len(theta) == k and tol > 0 and bool(np.all(res <= tol * np.abs(theta)))
         X = MX = None
         if done and accept is not None:
-            X, MX = Q[:, :m] @ Y, MQ[:, :m] @ Y
+            X = Q[:, :m] @ Y
+            MX = MQ[:, :m] @ Y if keep_mq else M @ X
             done = bool(accept(theta, X, MX))
         if done or m == max_steps:
             break
         if b > 1e-13 * scale:
             np.multiply(w, 1.0 / b, out=Q[:, m])
-            np.multiply(Mw, 1.0 / b, out=MQ[:, m])
+            np.multiply(Mw, 1.0 / b, out=mq(m))
             beta[m] = b
         else:  # the Krylov space closed: its Ritz pairs are exact; go on from a new direction
             if fresh is None or not start(m, fresh()):
                 break
             beta[m] = 0.0
     if X is None:
-        X, MX = Q[:, :steps] @ Y, MQ[:, :steps] @ Y
+        X = Q[:, :steps] @ Y
+        MX = MQ[:, :steps] @ Y if keep_mq else M @ X
     return Lanczos(theta=theta, vectors=X, m_vectors=MX, residuals=res, steps=steps,
                    converged=done)
 

@@ -21,7 +21,7 @@ six DOFs of a statically determinate 3-2-1 support, and the factorised matrix is
 without those six DOFs — positive definite, no spectral shift. Since ``G R = I`` per interface
 and ``K R = 0``, the rigid amplitudes ``a`` join the Lagrange multipliers in the small system
 ``[S E; Eᵀ 0][λ; a] = [g − G K⁻¹f; −Rᵀf]``. The fixed-interface eigen solve is shift-invert
-about 0 with that same factor (ARPACK mode 3, ``OP = P M`` with ``P`` the constrained inverse).
+about 0 with that same factor (Lanczos on ``OP = P M``, ``P`` the constrained inverse).
 ``factorize_s`` in the timings includes the ``6 m_d`` solves for ``K⁻¹ Gᵀ``.
 """
 
@@ -170,27 +170,34 @@ def support_321(points: np.ndarray, nodes: np.ndarray) -> np.ndarray:
 CONSTRAINT_BLOCK = 18
 
 
-def _fixed_interface_modes(K, M, solver, k, G):
-    """Lowest ``k`` eigenpairs of (K, M) on ker G: ARPACK shift-invert about 0 with ``solver``.
+def _fixed_interface_modes(M, solver, n, k):
+    """Lowest ``k`` eigenpairs of (K, M) on ker G: shift-invert Lanczos about 0 with ``solver``.
 
+    :func:`crankmodal.fem.modal.lanczos` (full reorthogonalisation, checked at every step), with
+    only the basis kept (not M times it: half the memory of the 150-step run 60 modes take).
     Neither sorted nor normalised: :func:`crankmodal.fem.modal.sort_and_normalise` does that
     once the factor is freed (normalising here was the memory peak of a 274k-DOF reduction).
 
-    (A block shift-invert Krylov with multi-RHS solves was tried: at 60 modes it needed ~280
-    vectors for residuals of 1e-5 and cost more CPU than ARPACK's ~1.5 ncv single solves.
-    At 60 modes ARPACK needed the same 151-153 solves for tol 1e-9 and 1e-12, and for 90 or
-    121 Lanczos vectors: the smaller basis saves 0.07 GB at the memory peak.)
+    At 255k P2 DOF (seed 000 crank, 9 interfaces) 60 modes took 153 solves: 28.6 s with
+    distributing and 23.8 s with rigid interfaces where ARPACK (``eigsh``, ``ncv`` 90, tol 1e-12)
+    took 40.0 s and 32.1 s; the 154-column basis is 0.3 GB more at the peak. (A block shift-invert
+    Krylov with multi-RHS solves was tried: at 60 modes it needed ~280 vectors for residuals of
+    1e-5 and cost more CPU than ARPACK.)
     """
-    from scipy.sparse.linalg import LinearOperator, eigsh
     from threadpoolctl import threadpool_limits
 
-    n = K.shape[0]
-    op = LinearOperator((n, n), matvec=lambda x: solver.solve(x), dtype=float)
-    v0 = np.random.default_rng(20240607).standard_normal(n)
+    from ..fem.modal import LANCZOS_TOL, lanczos
+
+    rng = np.random.default_rng(20240607)  # fixed: repeatable modes
+    v0 = solver.solve(M @ rng.standard_normal(n))  # in the constrained space (G x = 0)
     with threadpool_limits(limits=1, user_api="blas"):
-        lam, X = eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=op, v0=v0, tol=1e-12,
-                       ncv=min(n - 1, k + max(20, k // 2)))
-    return lam, X
+        out = lanczos(solver.solve, M, v0, k, LANCZOS_TOL, min(n - 1, 4 * k + 40),
+                      keep_mq=False)
+    if not out.converged:
+        raise NumericalError(
+            f"reduction: {k} fixed-interface modes did not converge in {out.steps} Lanczos "
+            f"steps; check the mesh for loose or degenerate elements, or keep fewer modes")
+    return 1.0 / out.theta, out.vectors
 
 
 def _residual_of(KX, MX, lam, G):
@@ -285,12 +292,11 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     timings["factorize_s"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    K_II = _restricted(K, I)  # eigsh only needs its shape (shift-invert with OPinv)
     n_free = len(I) - len(drows)
     if cutoff_hz is not None:
         k = min(20, n_free - 2)
         while True:
-            lam, X = _fixed_interface_modes(K_II, M_II, solver, k, G)
+            lam, X = _fixed_interface_modes(M_II, solver, len(I), k)
             f = np.sqrt(np.abs(lam)) / (2 * np.pi)
             if f.max() > cutoff_hz or k >= min(max_modes, n_free - 2):
                 break
@@ -301,7 +307,7 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
         if n_modes >= n_free - 1:
             raise SceneError(f"reduction.n_modes: {n_modes} modes need a finer mesh "
                              f"({n_free} interior DOFs)")
-        lam, X = _fixed_interface_modes(K_II, M_II, solver, n_modes, G)
+        lam, X = _fixed_interface_modes(M_II, solver, len(I), n_modes)
     else:
         lam, X = np.zeros(0), np.zeros((len(I), 0))
     timings["fixed_interface_modes_s"] = time.perf_counter() - t0
