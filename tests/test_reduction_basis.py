@@ -202,3 +202,21 @@ def test_cutoff_keeps_every_fixed_interface_mode_below_it(bar_model):
     cb = craig_bampton(model, itf, cutoff_hz=cut)
     assert cb.n_fixed_modes == 10
     assert np.allclose(cb.fixed_interface_hz, ref[:10], rtol=1e-9)
+
+
+def test_fixed_interface_pairs_of_a_tube_are_both_kept_when_few_modes_are_asked():
+    """Axisymmetric tube clamped at both ends (rigid end faces): its fixed-interface bending modes
+    come in equal pairs, and a short Lanczos run must keep both (the basis would otherwise bend
+    one way only)."""
+    from crankmodal.fem.materials import material
+    from crankmodal.fem.testparts import tube
+    from crankmodal.reduction.interfaces import make_interfaces
+
+    part = tube(0.02, 0.04, 0.3, divisions=(2, 16, 12), order=2)
+    model = assemble(part, material("steel"))
+    itf = make_interfaces(part, [{"region": "end_z0"}, {"region": "end_z1"}])
+    ref = craig_bampton(model, itf, n_modes=12).fixed_interface_hz
+    assert ref[1] == pytest.approx(ref[0], rel=1e-6) and ref[4] == pytest.approx(ref[3], rel=1e-6)
+    for k in (1, 2, 4, 5):
+        np.testing.assert_allclose(craig_bampton(model, itf, n_modes=k).fixed_interface_hz,
+                                   ref[:k], rtol=1e-8)
