@@ -67,8 +67,22 @@ def one(size: float, backend: str, n_modes: int) -> dict:
         "peak_assembly_gb": mem_asm.peak / 1e9, "peak_modal_gb": mem_modal.peak / 1e9,
         "peak_gb": max(mem_asm.peak, mem_modal.peak, rss_bytes()) / 1e9,
         "f_hz": [round(float(f), 2) for f in modes.frequencies_hz[:4]],
-        "rigid": modes.rigid_body_modes, "n_solves": modes.n_solves, "residual_max": float(modes.residuals.max()),
+        "rigid": modes.rigid_body_modes, "n_solves": modes.n_solves, "solve_s": modes.solve_time,
+        "residual_max": float(modes.residuals.max()),
     }
+
+
+def first_touch_s(gib: float = 1.0) -> float:
+    """Seconds a fresh process takes to write ``gib`` GiB of new memory: the machine's state.
+
+    On the reference VM this moved between 0.3 and 3 s per GiB from one half hour to the next
+    (host-side faults of memory the guest had handed back), and the factorisation, which writes
+    ~2.8 GB of new factor at 300k DOF, moves with it.
+    """
+    code = ("import time, numpy as np; t = time.perf_counter(); "
+            f"np.ones(int({gib} * 2**30 / 8)); print(time.perf_counter() - t)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return float(out.stdout.strip())
 
 
 def measure(size, backend, n_modes, timeout):
@@ -98,6 +112,8 @@ def main(argv=None):
         print(json.dumps(one(float(a.one[0]), a.one[1], int(a.one[2]))))
         return
     runs, rows = [], []
+    touch = [first_touch_s()]
+    print(f"machine: writing 1 GiB of new memory took {touch[0]:.2f} s", file=sys.stderr)
     for size in a.sizes:
         dofs = None
         for backend in ("auto", "superlu"):
@@ -122,8 +138,11 @@ def main(argv=None):
             med["mesh_s"] = max(r["mesh_s"] for r in reps if not r["mesh_cached"]) \
                 if any(not r["mesh_cached"] for r in reps) else float("nan")
             rows.append({**reps[0], **med, "repeats": len(reps)})
-    cols = ("n_dofs", "backend", "mesh_s", "assembly_s", "factorize_s", "lanczos_s", "modal_s",
-            "peak_gb")
+    touch.append(first_touch_s())
+    print(f"machine: writing 1 GiB of new memory took {touch[0]:.2f} s before the runs, "
+          f"{touch[1]:.2f} s after")
+    cols = ("n_dofs", "backend", "mesh_s", "assembly_s", "factorize_s", "lanczos_s", "solve_s",
+            "modal_s", "peak_gb")
     print("| part | " + " | ".join(cols) + " | f1..f4 Hz |")
     print("|" + "---|" * (len(cols) + 2))
     for r in rows:
@@ -135,7 +154,7 @@ def main(argv=None):
     if a.json:
         Path(a.json).parent.mkdir(parents=True, exist_ok=True)
         with open(a.json, "w") as fh:
-            json.dump({"runs": runs, "rows": rows}, fh, indent=1)
+            json.dump({"runs": runs, "rows": rows, "first_touch_gib_s": touch}, fh, indent=1)
 
 
 if __name__ == "__main__":
