@@ -110,10 +110,14 @@ class PardisoFactor:
         Symmetric; only its upper triangle is used.
     upper : bool
         ``A`` already is that upper triangle (saves a copy).
-    label : str
-        Prefix of error messages (``"modal: "``).
     positive_definite : bool
         ``True``: Cholesky (mtype 2); ``False``: Bunch-Kaufman LDLᵀ (mtype -2).
+    label : str
+        Prefix of error messages (``"modal: "``).
+
+    Between the analysis and the factorisation, PARDISO's estimate of the factor's peak memory
+    (``memory_needed``, bytes) is checked against what the machine has left
+    (:func:`check_memory`).
     """
 
     name = "pardiso"
