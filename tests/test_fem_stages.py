@@ -83,6 +83,8 @@ def test_supported_modal_and_static_stages_from_scene_tables(ctx):
     ({"supports": [{"region": "main_journal_9", "fix": "radial"}]},
      r"modal.supports\[0\].region: no region 'main_journal_9'"),
     ({"supports": [{"box": [0, 1, 0, 1, 5, 6], "fix": "x"}]}, r"modal.supports\[0\]: selects no node"),
+    ({"supports": [{"region": "end_x0", "fix": "radial"}]},  # a flat face is no bore
+     r"modal.supports\[0\].fix: 'radial' needs a cylindrical region; region 'end_x0' is flat"),
 ])
 def test_supports_that_select_nothing_name_the_entry(ctx, raw, match):
     with pytest.raises(SceneError, match=match):
@@ -110,6 +112,8 @@ def test_malformed_modal_tables_are_refused_before_running(raw, match):
      r"static.loads\[0\].force"),
     ({"supports": [{"region": "end_x0"}], "loads": [{"region": "end_x1", "pressure": 1, "force": [1, 2, 3]}]},
      "exactly one"),
+    ({"supports": [{"region": "end_x0"}], "loads": [{"region": "end_x1", "bearing_force": [1, 2]}]},
+     r"static.loads\[0\].bearing_force: must be 3 numbers"),
 ])
 def test_malformed_static_tables_are_refused(raw, match):
     with pytest.raises(SceneError, match=match):
@@ -125,3 +129,8 @@ def test_static_stage_refuses_a_mechanism_and_unknown_load_region(ctx):
                                "loads": [{"region": "crankpin", "pressure": 1e5}]}, SCENE)
     with pytest.raises(SceneError, match=r"static.loads\[0\].region: no region 'crankpin'"):
         static_stage.run(p, ctx)
+    p = static_stage.validate({"supports": [{"region": "end_x0"}],
+                               "loads": [{"region": "end_x1", "bearing_force": [0, 1e3, 0]}]}, SCENE)
+    with pytest.raises(SceneError, match=r"static.loads\[0\].bearing_force: needs a cylindrical "
+                                         r"region; region 'end_x1' is flat"):
+        static_stage.run(p, ctx)  # a flat end face has no bore to press on

@@ -145,3 +145,33 @@ def test_seed000_table2_rod_row_runs_from_its_scene_with_the_shank_at_f_over_a(t
     assert junction - 0.006 < loc[0] < junction + 0.001
     assert 1.5 < res.max_von_mises / (F / A) < 4.0  # a concentration, seed: 29.95 / 11.97 = 2.5
     assert res.safety_factor_ultimate == pytest.approx(930e6 / res.max_von_mises)
+
+
+def test_bearing_load_is_a_cosine_pressure_on_the_loaded_half_of_the_bore():
+    """A pin's radial force on a bore: nodal forces add up to F exactly, sit only on the half
+    facing F, and near θ = 0 equal cos θ times those of a uniform pressure p0 = 2F/(πRL)."""
+    part = tube(0.02, 0.04, 0.05, divisions=(2, 32, 4), order=2)
+    model = assembly.assemble(part, STEEL)
+    reg = part.regions["bore"]
+    cyl = reg.cylinder
+    F = np.array([0.0, -3000.0, 0.0])
+    f = loads.bearing_load(model.points, model.cells, reg.facets, F, cyl.centre, cyl.axis)
+    f3 = f.reshape(-1, 3)
+    np.testing.assert_allclose(f3.sum(axis=0), F, atol=1e-9 * 3000)
+    x = model.points - cyl.centre
+    er = x - np.outer(x @ cyl.axis, cyl.axis)
+    er /= np.maximum(np.linalg.norm(er, axis=1, keepdims=True), 1e-300)
+    cos = er @ (F / 3000.0)
+    loaded = np.linalg.norm(f3, axis=1) > 0
+    assert np.all(cos[loaded] > -0.2)  # only facets reaching the loaded half carry load
+    # (P2 corner nodes of a pressure can carry small negative shares: nodes, not signs, checked)
+    p0 = 2 * 3000.0 / (np.pi * cyl.radius * cyl.length)
+    uniform = loads.pressure_load(model.points, model.cells, reg.facets, p0).reshape(-1, 3)
+    for edge in (0.99, 0.5):  # summed over bands (P2 shares move between a facet's nodes)
+        band = reg.nodes[cos[reg.nodes] > edge]
+        radial = np.einsum("ij,ij->i", f3[band], er[band]).sum()
+        expect = (cos[band] * np.einsum("ij,ij->i", uniform[band], er[band])).sum()
+        assert radial == pytest.approx(expect, rel=0.02)
+    with pytest.raises(SceneError, match="along the bore axis"):
+        loads.bearing_load(model.points, model.cells, reg.facets, [0, -3000.0, 50.0],
+                           cyl.centre, cyl.axis)

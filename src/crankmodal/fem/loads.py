@@ -1,4 +1,5 @@
-"""Consistent nodal loads on boundary regions: pressure, total force, remote force (RBE3).
+"""Consistent nodal loads on boundary regions: pressure, total force, remote force (RBE3), and
+a pin's force on a bore (bearing load).
 
 Region facets are corner triangles; on a ``tetra10`` mesh their mid-edge nodes are looked up in
 the volume connectivity and the 6-node facets are integrated isoparametrically (a pressure on a
@@ -148,3 +149,41 @@ def remote_force(points, cells, facets, force, point=None, moment=None) -> np.nd
     out = np.zeros((len(points), 3))
     out[u] = fa
     return out.ravel()
+
+
+def bearing_load(points, cells, facets, force, centre, axis) -> np.ndarray:
+    """A pin's radial force (N) on a bore: a pressure ``p0 cos θ`` on the half it pushes against.
+
+    θ is the angle between the force and the radial direction e_r (from the bore axis into the
+    wall); the pressure acts on the wall where cos θ > 0, along e_r, and is zero elsewhere — the
+    usual "bearing load" of a strength check (a pin in a clearance-free bore, no friction).
+    ``p0`` is set so that the nodal forces add up to the force along it exactly
+    (analytically ``p0 = 2 |F| / (π R L)``).
+
+    Parameters
+    ----------
+    force : (3,) array
+        N, perpendicular to the axis (a pressure on a cylinder carries no axial force).
+    centre, axis : (3,) arrays
+        A point on the bore axis (m) and its direction.
+    """
+    F = np.asarray(force, float)
+    d = np.asarray(axis, float) / np.linalg.norm(axis)
+    fn = np.linalg.norm(F)
+    if fn == 0.0:
+        return np.zeros(3 * len(points))
+    if abs(F @ d) > 1e-6 * fn:
+        raise SceneError(f"bearing_force: {F.tolist()} N has {F @ d:.4g} N along the bore axis; "
+                         f"a bearing load is radial (give the axial part as a force)")
+    fhat = F / fn
+    nodes, N, nda = facet_quadrature(points, cells, facets)
+    x = np.einsum("qk,fkc->fqc", N, points[nodes])  # quadrature points
+    r = x - np.asarray(centre, float)
+    r -= np.einsum("fqc,c->fq", r, d)[..., None] * d
+    er = r / np.linalg.norm(r, axis=2, keepdims=True)
+    c = np.maximum(np.einsum("fqc,c->fq", er, fhat), 0.0)  # cos θ on the loaded half
+    da = np.linalg.norm(nda, axis=2)
+    t = c[..., None] * er * da[..., None]  # traction per unit p0 times the area weight
+    p0 = fn / float(np.einsum("fqc,c->", t, fhat))
+    vals = p0 * np.einsum("qk,fqc->fkc", N, t)
+    return _scatter(len(points), nodes, vals)

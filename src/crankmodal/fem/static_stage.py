@@ -24,12 +24,13 @@ REQUIRES = ("geometry", "material")
 SCHEMA: dict[str, Field] = {
     "supports": Field("tables", None, "supports as in [modal]; must remove every rigid-body mode"),
     "loads": Field("tables", None, "{region, pressure (Pa)} | {region, force [N]} | "
-                   "{region, remote_force [N], point [m], moment [N m]}"),
+                   "{region, remote_force [N], point [m], moment [N m]} | "
+                   "{region, bearing_force [N]} (a pin on a cylindrical bore, cos-distributed)"),
     "backend": BACKEND_FIELD,
     "vtu": Field("bool", True, "write displacement and stresses to static.vtu"),
 }
 
-_KINDS = ("pressure", "force", "remote_force")
+_KINDS = ("pressure", "force", "remote_force", "bearing_force")
 
 
 def validate_loads(loads, section: str = SECTION) -> list[dict]:
@@ -54,7 +55,7 @@ def validate_loads(loads, section: str = SECTION) -> list[dict]:
             v = ld["pressure"]
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
                 raise SceneError(f"{key}.pressure: must be a number (Pa), got {v!r}")
-        for vec in ("force", "remote_force", "point", "moment"):
+        for vec in ("force", "remote_force", "bearing_force", "point", "moment"):
             if vec in ld:
                 v = ld[vec]
                 if (not isinstance(v, (list, tuple)) or len(v) != 3 or not all(
@@ -93,6 +94,21 @@ def load_vector(part, model, loads) -> np.ndarray:
             f += L.pressure_load(model.points, model.cells, facets, float(ld["pressure"]))
         elif ld["kind"] == "force":
             f += L.traction_force(model.points, model.cells, facets, ld["force"])
+        elif ld["kind"] == "bearing_force":
+            cyl = part.regions[name].cylinder
+            if cyl is None:
+                from .supports import fit_cylinder
+
+                try:
+                    cyl = fit_cylinder(model.points, facets)
+                except ValueError as exc:
+                    raise SceneError(f"{SECTION}.loads[{i}].bearing_force: needs a cylindrical "
+                                     f"region; region {name!r} is {exc}") from None
+            try:
+                f += L.bearing_load(model.points, model.cells, facets, ld["bearing_force"],
+                                    cyl.centre, cyl.axis)
+            except SceneError as exc:
+                raise SceneError(f"{SECTION}.loads[{i}].{exc}") from None
         else:
             f += L.remote_force(model.points, model.cells, facets, ld["remote_force"],
                                 ld.get("point"), ld.get("moment"))

@@ -55,15 +55,18 @@ def check_fix(fix: str) -> str | None:
 def fit_cylinder(points: np.ndarray, facets: np.ndarray):
     """Least-squares cylinder through a region's nodes (axis from the facet normals).
 
-    Returns a :class:`~crankmodal.part.Cylinder`; raises ``ValueError`` if the region is not
-    cylindrical to 1 % of its radius.
+    Returns a :class:`~crankmodal.part.Cylinder`; raises ``ValueError`` if the region is flat or
+    not cylindrical to 1 % of its radius.
     """
     from ..part import Cylinder
 
     p = points[facets]
     n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     n /= np.linalg.norm(n, axis=1, keepdims=True)
-    axis = np.linalg.svd(n, full_matrices=False)[2][-1]
+    _, sv, vt = np.linalg.svd(n, full_matrices=False)
+    if sv[1] < 1e-3 * sv[0]:  # the normals of a cylinder turn about its axis; a plane's do not
+        raise ValueError("flat (its facet normals do not turn)")
+    axis = vt[-1]
     x = points[np.unique(facets)]
     s = x @ axis
     e1 = np.linalg.svd(n - np.outer(n @ axis, axis), full_matrices=False)[2][0]
