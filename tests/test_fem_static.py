@@ -175,3 +175,10 @@ def test_bearing_load_is_a_cosine_pressure_on_the_loaded_half_of_the_bore():
     with pytest.raises(SceneError, match="along the bore axis"):
         loads.bearing_load(model.points, model.cells, reg.facets, [0, -3000.0, 50.0],
                            cyl.centre, cyl.axis)
+    # a journal (the tube's outer surface) pressed by a shell: loaded on the side facing away
+    # from the force, pushed inward
+    out = part.regions["outer"]
+    g3 = loads.bearing_load(model.points, model.cells, out.facets, F, out.cylinder.centre,
+                            out.cylinder.axis).reshape(-1, 3)
+    np.testing.assert_allclose(g3.sum(axis=0), F, atol=1e-9 * 3000)
+    assert np.all(cos[np.linalg.norm(g3, axis=1) > 0] < 0.2)

@@ -152,20 +152,21 @@ def remote_force(points, cells, facets, force, point=None, moment=None) -> np.nd
 
 
 def bearing_load(points, cells, facets, force, centre, axis) -> np.ndarray:
-    """A pin's radial force (N) on a bore: a pressure ``p0 cos θ`` on the half it pushes against.
+    """A radial force (N) through a cylindrical bearing surface, as a pressure ``p0 cos θ``.
 
-    θ is the angle between the force and the radial direction e_r (from the bore axis into the
-    wall); the pressure acts on the wall where cos θ > 0, along e_r, and is zero elsewhere — the
-    usual "bearing load" of a strength check (a pin in a clearance-free bore, no friction).
-    ``p0`` is set so that the nodal forces add up to the force along it exactly
-    (analytically ``p0 = 2 |F| / (π R L)``).
+    θ is the angle between the force and the direction the surface is pressed in (minus its
+    outward normal): a pin pressing a bore (a rod's eye) loads the wall on the force's side, a
+    shell pressing a journal (a crankpin) loads the journal on the side facing away from it.
+    Where cos θ ≤ 0 there is no pressure — the usual "bearing load" of a strength check
+    (no clearance, no friction). ``p0`` is set so that the nodal forces add up to the force
+    exactly (analytically ``p0 = 2 |F| / (π R L)``).
 
     Parameters
     ----------
     force : (3,) array
         N, perpendicular to the axis (a pressure on a cylinder carries no axial force).
     centre, axis : (3,) arrays
-        A point on the bore axis (m) and its direction.
+        A point on the cylinder's axis (m, unused but for the check) and its direction.
     """
     F = np.asarray(force, float)
     d = np.asarray(axis, float) / np.linalg.norm(axis)
@@ -176,14 +177,10 @@ def bearing_load(points, cells, facets, force, centre, axis) -> np.ndarray:
         raise SceneError(f"bearing_force: {F.tolist()} N has {F @ d:.4g} N along the bore axis; "
                          f"a bearing load is radial (give the axial part as a force)")
     fhat = F / fn
-    nodes, N, nda = facet_quadrature(points, cells, facets)
-    x = np.einsum("qk,fkc->fqc", N, points[nodes])  # quadrature points
-    r = x - np.asarray(centre, float)
-    r -= np.einsum("fqc,c->fq", r, d)[..., None] * d
-    er = r / np.linalg.norm(r, axis=2, keepdims=True)
-    c = np.maximum(np.einsum("fqc,c->fq", er, fhat), 0.0)  # cos θ on the loaded half
+    nodes, N, nda = facet_quadrature(points, cells, facets)  # outward normal x area weight
     da = np.linalg.norm(nda, axis=2)
-    t = c[..., None] * er * da[..., None]  # traction per unit p0 times the area weight
+    c = np.maximum(-np.einsum("fqc,c->fq", nda, fhat) / da, 0.0)  # cos θ on the loaded half
+    t = -c[..., None] * nda  # traction per unit p0 (pushing into the surface), times the weight
     p0 = fn / float(np.einsum("fqc,c->", t, fhat))
     vals = p0 * np.einsum("qk,fqc->fkc", N, t)
     return _scatter(len(points), nodes, vals)
