@@ -151,7 +151,7 @@ def remote_force(points, cells, facets, force, point=None, moment=None) -> np.nd
     return out.ravel()
 
 
-def bearing_load(points, cells, facets, force, centre, axis) -> np.ndarray:
+def bearing_load(points, cells, facets, force, axis) -> np.ndarray:
     """A radial force (N) through a cylindrical bearing surface, as a pressure ``p0 cos θ``.
 
     θ is the angle between the force and the direction the surface is pressed in (minus its
@@ -165,8 +165,8 @@ def bearing_load(points, cells, facets, force, centre, axis) -> np.ndarray:
     ----------
     force : (3,) array
         N, perpendicular to the axis (a pressure on a cylinder carries no axial force).
-    centre, axis : (3,) arrays
-        A point on the cylinder's axis (m, unused but for the check) and its direction.
+    axis : (3,) array
+        The cylinder's axis direction (the force must be perpendicular to it).
     """
     F = np.asarray(force, float)
     d = np.asarray(axis, float) / np.linalg.norm(axis)

@@ -73,6 +73,3 @@ class RowBlocks:
         for f in futures:
             f.result()
         return out
-
-    def diagonal(self):
-        return self.matrix.diagonal()

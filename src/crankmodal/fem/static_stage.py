@@ -95,18 +95,13 @@ def load_vector(part, model, loads) -> np.ndarray:
         elif ld["kind"] == "force":
             f += L.traction_force(model.points, model.cells, facets, ld["force"])
         elif ld["kind"] == "bearing_force":
-            cyl = part.regions[name].cylinder
-            if cyl is None:
-                from .supports import fit_cylinder
+            from .supports import region_cylinder
 
-                try:
-                    cyl = fit_cylinder(model.points, facets)
-                except ValueError as exc:
-                    raise SceneError(f"{SECTION}.loads[{i}].bearing_force: needs a cylindrical "
-                                     f"region; region {name!r} is {exc}") from None
+            cyl = region_cylinder(part.regions[name], name, model.points,
+                                  f"{SECTION}.loads[{i}].bearing_force:")
             try:
                 f += L.bearing_load(model.points, model.cells, facets, ld["bearing_force"],
-                                    cyl.centre, cyl.axis)
+                                    cyl.axis)
             except SceneError as exc:
                 raise SceneError(f"{SECTION}.loads[{i}].{exc}") from None
         else:

@@ -82,6 +82,19 @@ def fit_cylinder(points: np.ndarray, facets: np.ndarray):
     return Cylinder(centre=centre, axis=axis, radius=float(radius), length=float(np.ptp(s)))
 
 
+def region_cylinder(region, name: str, points: np.ndarray, what: str):
+    """The region's exact cylinder from the geometry, else one fitted to its nodes.
+
+    Raises :class:`SceneError` starting with ``what`` when the region is not cylindrical.
+    """
+    if region.cylinder is not None:
+        return region.cylinder
+    try:
+        return fit_cylinder(points, np.asarray(region.facets))
+    except ValueError as exc:
+        raise SceneError(f"{what} needs a cylindrical region; region {name!r} is {exc}") from None
+
+
 def validate_specs(specs, section: str = "modal") -> list[dict]:
     """Check support tables without a part; returns them with ``fix`` defaulted to ``xyz``.
 
@@ -152,13 +165,7 @@ def select(part, specs, section: str = "modal") -> list[Support]:
             nodes = np.asarray(reg.nodes, np.int64)
             label = f"{key} (region {name})"
             if fix == "radial":
-                cyl = reg.cylinder
-                if cyl is None:
-                    try:
-                        cyl = fit_cylinder(points, np.asarray(reg.facets))
-                    except ValueError as exc:
-                        raise SceneError(f"{key}.fix: 'radial' needs a cylindrical region; "
-                                         f"region {name!r} is {exc}") from None
+                cyl = region_cylinder(reg, name, points, f"{key}.fix: 'radial'")
         else:
             box = spec["box"]
             lo, hi = np.array(box[0::2], float), np.array(box[1::2], float)
