@@ -189,10 +189,13 @@ def _fixed_interface_modes(M, solver, n, k):
     from ..fem.modal import LANCZOS_TOL, lanczos
 
     rng = np.random.default_rng(20240607)  # fixed: repeatable modes
-    v0 = solver.solve(M @ rng.standard_normal(n))  # in the constrained space (G x = 0)
+
+    def fresh():  # a start vector in the constrained space (G x = 0)
+        return solver.solve(M @ rng.standard_normal(n))
+
     with threadpool_limits(limits=1, user_api="blas"):
-        out = lanczos(solver.solve, M, v0, k, LANCZOS_TOL, min(n - 1, 4 * k + 40),
-                      keep_mq=False)
+        out = lanczos(solver.solve, M, fresh(), k, LANCZOS_TOL, min(n - 1, 4 * k + 40),
+                      fresh=fresh, keep_mq=False)
     if not out.converged:
         raise NumericalError(
             f"reduction: {k} fixed-interface modes did not converge in {out.steps} Lanczos "
