@@ -221,6 +221,37 @@ def test_repeated_pairs_of_a_tube_are_both_found_when_few_modes_are_asked():
                                    rtol=1e-8)
 
 
+def test_completeness_check_finds_the_partner_a_single_vector_lanczos_cannot_see():
+    """K = diag(1, 1, 2, 3, ...): from any start vector the Krylov space holds one vector of the
+    double eigenspace, so Lanczos alone returns 1, 2, 3; the check must bring back 1, 1, 2."""
+    import scipy.sparse as sp
+
+    n = 40
+    d = np.r_[1.0, 1.0, np.arange(2.0, n)]
+    M = sp.identity(n, format="csr")
+    sigma = -0.5
+
+    def apply(b):
+        return b / (d - sigma)
+
+    main = modal.lanczos(apply, M, np.ones(n), 3, 1e-12, n - 1)
+    np.testing.assert_allclose(np.sort(sigma + 1 / main.theta), [1, 2, 3], rtol=1e-12)
+    rng = np.random.default_rng(0)
+
+    def run(op, k, start, room):
+        return modal.lanczos(op, M, start(), k, 1e-12, min(room, n - 1), fresh=start)
+
+    lam, X, MX = modal.complete_modes(apply, lambda: rng.standard_normal(n), M, run,
+                                      sigma + 1 / main.theta, main.vectors, main.m_vectors,
+                                      sigma, 3)
+    np.testing.assert_allclose(lam, [1, 1, 2], rtol=1e-12)
+    np.testing.assert_allclose(X.T @ X, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(MX, M @ X, atol=1e-14)
+    # the first two span the double eigenspace (DOFs 0, 1), the third is DOF 2 alone
+    assert np.abs(X[2:, :2]).max() < 1e-10
+    assert np.abs(np.delete(X[:, 2], 2)).max() < 1e-10
+
+
 def _pencil(n=60, seed=3):
     """A small SPD pencil (K, M) with distinct eigenvalues, and its dense solution."""
     import scipy.linalg as sla

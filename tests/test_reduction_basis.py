@@ -220,3 +220,22 @@ def test_fixed_interface_pairs_of_a_tube_are_both_kept_when_few_modes_are_asked(
     for k in (1, 2, 4, 5):
         np.testing.assert_allclose(craig_bampton(model, itf, n_modes=k).fixed_interface_hz,
                                    ref[:k], rtol=1e-8)
+
+
+def test_fixed_interface_modes_bring_back_the_partner_of_an_exactly_repeated_pair():
+    """A constrained solver with the spectrum 1, 1, 2, 3, ... (M = I): a single-vector Lanczos
+    run sees one vector of the double eigenspace; the completeness check must add the other."""
+    import scipy.sparse as sp
+
+    from crankmodal.reduction.craig_bampton import _fixed_interface_modes
+
+    n = 200  # the rest far above: the run converges before its Krylov space closes and restarts
+    d = np.r_[1.0, 1.0, 2.0, 3.0, np.linspace(10.0, 1000.0, n - 4)]
+
+    class Diagonal:
+        def solve(self, b):
+            return b / d if b.ndim == 1 else b / d[:, None]
+
+    lam, X = _fixed_interface_modes(sp.identity(n, format="csr"), Diagonal(), n, 3)
+    np.testing.assert_allclose(np.sort(lam), [1, 1, 2], rtol=1e-10)
+    np.testing.assert_allclose(X.T @ X, np.eye(3), atol=1e-10)

@@ -332,6 +332,86 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
                    converged=done)
 
 
+def deflated(apply, fresh, D: np.ndarray, MD: np.ndarray):
+    """The operator and start vectors with the M-orthonormal columns of ``D`` kept out.
+
+    Returns ``(op, start)``: ``op(b) = P apply(b)`` and ``start() = P fresh()`` with the
+    M-orthogonal projector ``P x = x − D (MDᵀ x)`` (``MD = M D``).
+    """
+    if not D.shape[1]:
+        return apply, fresh
+
+    def project(x):
+        return x - D @ (MD.T @ x)
+
+    return (lambda b: project(apply(b))), (lambda: project(fresh()))
+
+
+def complete_modes(apply, fresh, M, run, lam: np.ndarray, X: np.ndarray, MX: np.ndarray,
+                   sigma: float, k: int, what: str = "modal",
+                   kept: tuple | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Find the modes a single-vector Lanczos run missed below the highest one it found.
+
+    A Krylov space from one start vector holds one vector of each eigenspace: the second mode of
+    an exactly repeated pair (an axisymmetric shaft or tube) can only come in through rounding.
+    :data:`COMPLETENESS_STEPS` Lanczos steps from a fresh start, with the found modes kept out,
+    look for a Ritz value above the highest found one; when there is one, ``run`` hunts the
+    missed modes down (at most :data:`MAX_RESCUES` times) and the lowest ``k`` of all are kept.
+
+    Parameters
+    ----------
+    apply : callable
+        ``b -> (K − σM)⁻¹ b``.
+    fresh : callable
+        ``() -> vector``: a random start direction in the space ``apply`` maps into.
+    M : sparse matrix or LinearOperator
+    run : callable
+        ``(op, k_run, start, room) -> Lanczos``: the caller's converged Lanczos run of ``k_run``
+        pairs of the operator ``op`` from ``start()`` (``start`` also gives restarts), in at
+        most ``room`` steps (the dimension left).
+    lam, X, MX : ndarray
+        Eigenvalues found (rad²/s²), their M-orthonormal vectors and M times them.
+    sigma : float
+        The shift, rad²/s² (``λ = σ + 1/θ``).
+    k : int
+        Pairs wanted.
+    what : str
+        Prefix of the error message.
+    kept : (R, MR), optional
+        M-orthonormal vectors to keep out as well (the known rigid-body modes), M times them.
+
+    Returns
+    -------
+    lam, X, MX : the lowest ``k`` pairs (ascending when anything was added).
+
+    Raises
+    ------
+    NumericalError
+        Modes still escape after :data:`MAX_RESCUES` runs.
+    """
+    n = X.shape[0]
+    for attempt in range(MAX_RESCUES + 1):
+        D, MD = (X, MX) if kept is None else (np.hstack([kept[0], X]), np.hstack([kept[1], MX]))
+        if n - D.shape[1] <= COMPLETENESS_STEPS + 1:
+            break
+        op, start = deflated(apply, fresh, D, MD)
+        theta = lanczos(op, M, start(), 1, 0.0, COMPLETENESS_STEPS).theta[0]
+        if theta <= (1 + 1e-6) / (lam.max() - sigma):
+            break
+        if attempt == MAX_RESCUES:
+            raise NumericalError(
+                f"{what}: modes below {np.sqrt(abs(lam.max())) / (2 * np.pi):.6g} Hz keep "
+                f"escaping the Lanczos iteration (repeated frequencies); ask for more modes or "
+                f"break the part's symmetry slightly")
+        extra = run(op, min(k, n - D.shape[1] - 2), start, n - D.shape[1])
+        lam = np.r_[lam, sigma + 1.0 / extra.theta]
+        keep = np.argsort(lam)[:k]
+        lam = lam[keep]
+        X = np.hstack([X, extra.vectors])[:, keep]
+        MX = np.hstack([MX, extra.m_vectors])[:, keep]
+    return lam, X, MX
+
+
 def stall_advice(model: FEModel) -> str:
     """What to change when the eigenpairs cannot be made accurate: the material or the mesh."""
     nu = float(model.material.nu)
@@ -477,20 +557,14 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             lam_r, W = np.linalg.eigh(Rq.T @ (K @ Rq))
             Xr = Rq @ W
         R0 = Rq if deflate else np.zeros((n, 0))  # M-orthonormal, kept out of the Krylov space
-        D, MD = R0, M @ R0
-
-        def project(x):
-            return x - D @ (MD.T @ x) if D.shape[1] else x
+        MR0 = M @ R0
 
         def solve(b, _fac=fac):
             n_solves[0] += 1
             t = time.perf_counter()
             x = _fac.solve(b)
             solve_time[0] += time.perf_counter() - t
-            return project(x)
-
-        def fresh():
-            return project(rng.standard_normal(n))
+            return x
 
         last = {}
 
@@ -510,11 +584,11 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             return (before is not None and len(before) == len(r) and bool(np.all(r <= tol))
                     and r.max() > 0.5 * before.max())
 
-        def run(apply, k_run, v0):
+        def run(op, k_run, start, room):
             """Lowest k_run modes of the deflated pencil (raises when Lanczos does not converge)."""
-            steps = min(n - D.shape[1], max(4 * k_run + 40, 60))
+            steps = min(room, max(4 * k_run + 40, 60))
             last.clear()  # the floor test compares calls within one run
-            out = lanczos(apply, M, v0, k_run, LANCZOS_TOL, steps, fresh=fresh, accept=accept)
+            out = lanczos(op, M, start(), k_run, LANCZOS_TOL, steps, fresh=start, accept=accept)
             if not out.converged and "r" in last:  # the Lanczos estimates converged, the pairs not
                 raise NumericalError(
                     f"modal: the eigen-residuals ‖Kx − λMx‖/‖Kx‖ stall at {last['r'].max():.1e} "
@@ -531,30 +605,11 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         # one BLAS thread for the small dense work of the loop (two were 5-7x slower); PARDISO
         # sets its own MKL threads per call
         with threadpool_limits(limits=1, user_api="blas"):
-            main = run(solve, k, fresh())
-            lam, X, MX = sigma + 1.0 / main.theta, main.vectors, main.m_vectors
-            # completeness: a single-vector Lanczos cannot see the second mode of an exactly
-            # repeated pair (an axisymmetric shaft or tube). Look below the highest mode found
-            # with a few Lanczos steps from a fresh start; if one is there, hunt it down.
-            for attempt in range(MAX_RESCUES + 1):
-                if n - D.shape[1] - len(lam) <= COMPLETENESS_STEPS + 1:
-                    break
-                D = np.hstack([R0, X])  # M-orthonormal: the Lanczos vectors are
-                MD = np.hstack([M @ R0, MX])
-                theta = lanczos(solve, M, fresh(), 1, 0.0, COMPLETENESS_STEPS).theta[0]
-                if theta <= (1 + 1e-6) / (lam.max() - sigma):
-                    break
-                if attempt == MAX_RESCUES:
-                    raise NumericalError(
-                        f"modal: modes below {np.sqrt(abs(lam.max())) / (2 * np.pi):.6g} Hz "
-                        f"keep escaping the Lanczos iteration (repeated frequencies); ask for "
-                        f"more modes (n_modes) or break the part's symmetry slightly")
-                extra = run(solve, min(k, n - D.shape[1] - 2), fresh())
-                lam = np.r_[lam, sigma + 1.0 / extra.theta]
-                keep = np.argsort(lam)[:k]
-                lam = lam[keep]
-                X = np.hstack([X, extra.vectors])[:, keep]
-                MX = np.hstack([MX, extra.m_vectors])[:, keep]
+            op, start = deflated(solve, lambda: rng.standard_normal(n), R0, MR0)
+            main = run(op, k, start, n - R0.shape[1])
+            lam, X, _ = complete_modes(
+                solve, lambda: rng.standard_normal(n), M, run, sigma + 1.0 / main.theta,
+                main.vectors, main.m_vectors, sigma, k, kept=(R0, MR0) if R0.shape[1] else None)
         if deflate:
             lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
         backend_name = fac.name
