@@ -242,6 +242,25 @@ def test_needle_elements_stop_the_run_with_advice_instead_of_returning_poor_pair
         modal.solve_modes(model, 4)
 
 
+def test_nearly_repeated_bending_pairs_of_a_square_bar_are_both_found_and_perpendicular():
+    """Square section: each bending frequency is a pair, split only by the tetrahedral mesh
+    (3e-5 here). Both members must come back, each on Timoshenko's value, bending in
+    perpendicular planes."""
+    a = 0.04
+    m = modal.solve_modes(assembly.assemble(bar(L, a, a, (40, 3, 3), order=2), STEEL), 4)
+    f = m.frequencies_hz
+    ft = timoshenko_frequencies(2, L, STEEL.E, STEEL.nu, STEEL.rho, a * a, a**4 / 12,
+                                rectangle_shear_coefficient(STEEL.nu), ends="free-free")
+    np.testing.assert_allclose(f, np.repeat(ft, 2), rtol=0.005)
+    assert abs(f[1] / f[0] - 1) < 1e-3 and abs(f[3] / f[2] - 1) < 1e-3
+    for i in (0, 2):
+        dirs = []
+        for j in (i, i + 1):
+            u = m.shapes[:, j].reshape(-1, 3)[:, 1:]  # transverse (y, z) motion of every node
+            dirs.append(np.linalg.eigh(u.T @ u)[1][:, -1])  # the direction it bends in
+        assert abs(dirs[0] @ dirs[1]) < 1e-2
+
+
 def test_completeness_check_finds_the_partner_a_single_vector_lanczos_cannot_see():
     """K = diag(1, 1, 2, 3, ...): from any start vector the Krylov space holds one vector of the
     double eigenspace, so Lanczos alone returns 1, 2, 3; the check must bring back 1, 1, 2."""
