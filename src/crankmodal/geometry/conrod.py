@@ -58,6 +58,47 @@ def _shank(gmsh, p: ConrodParams, full: bool) -> list:
     return shank
 
 
+def _on_eye(xyz: np.ndarray, centre_x: float, radius: float, tol: float = 1e-6) -> bool:
+    """Whether all points lie on the eye cylinder of axis z through (centre_x, 0)."""
+    return bool(np.all(np.abs(np.hypot(xyz[:, 0] - centre_x, xyz[:, 1]) - radius) < tol))
+
+
+def small_end_transition_edges(gmsh, p: ConrodParams, tol: float = 1e-6) -> list:
+    """Curves of the fused (bore-less) rod where the shank's outer faces meet the small eye.
+
+    The section's outer faces are the planes |y| = y_max and |z| = z_max of its bounding box:
+    the flanges' outer and side faces (I-section). Their curves on the small eye's cylinder, off
+    the eye's own faces, are the concave edges the transition fillet rounds.
+    """
+    h, b = p.shank_depth, p.shank_width
+    ymax, zmax = (h / 2, b / 2) if p.shank_section == "I" else (b / 2, h / 2)
+    rso, half = p.small_end_outer_diameter / 2, p.small_end_width / 2
+    edges = []
+    for _, c in gmsh.model.getEntities(1):
+        lo, hi = gmsh.model.getParametrizationBounds(1, c)
+        xyz = np.asarray(gmsh.model.getValue(1, c, np.linspace(lo[0], hi[0], 7))).reshape(-1, 3)
+        y, z = np.abs(xyz[:, 1]), np.abs(xyz[:, 2])
+        inside = np.all(y <= ymax + tol) and np.all(z <= zmax + tol)
+        on_face = np.all(np.abs(y - ymax) < tol) or np.all(np.abs(z - zmax) < tol)
+        if inside and on_face and np.any(z < half - tol) and _on_eye(xyz, p.length, rso, tol):
+            edges.append(c)
+    return edges
+
+
+def _small_end_fillet(gmsh, p: ConrodParams, body: list) -> list:
+    """Round the flanges' outer and side faces into the small eye (one OCC fillet).
+
+    The section's inner edges (web and flange inner faces) stay sharp: OCC fails on them
+    together with these, or builds a self-intersecting blend. At a flange's outer corner the two
+    fillets end capped by the flange's planes (OCC's corner for a convex edge between them).
+    """
+    occ = gmsh.model.occ
+    occ.synchronize()
+    body = occ.fillet([t for _, t in body], small_end_transition_edges(gmsh, p), [p.small_end_fillet])
+    occ.synchronize()
+    return body
+
+
 def build_conrod(gmsh, p: ConrodParams, fidelity: str):
     """Make the connecting rod in the current gmsh model (synchronised on return).
 
@@ -85,6 +126,8 @@ def build_conrod(gmsh, p: ConrodParams, fidelity: str):
             parts.append((3, occ.addBox(-hb / 2, lo, -bb / 2, hb, rbo + p.bolt_boss_width - y0, bb)))
     parts += _shank(gmsh, p, full)
     body, _ = occ.fuse(parts[:1], parts[1:])
+    if full and p.small_end_fillet > 0:  # on the plain body: bores and split plane come after
+        body = _small_end_fillet(gmsh, p, body)
     tools = [(3, occ.addCylinder(0, 0, -bb, 0, 0, 2 * bb, rbi)),
              (3, occ.addCylinder(L, 0, -bs, 0, 0, 2 * bs, rsi))]
     if full and p.bolt_diameter > 0:
@@ -116,4 +159,6 @@ def build_conrod(gmsh, p: ConrodParams, fidelity: str):
     detail = 0.5 * min(rb, p.shank_flange_thickness, p.shank_web_thickness)
     if full and p.bolt_diameter > 0:
         detail = max(detail, 0.51 * p.bolt_diameter)
+    if full and p.small_end_fillet > 0:
+        detail = max(detail, 1.02 * p.small_end_fillet)
     return volumes, specs, {"radius": detail, "faces": []}

@@ -139,6 +139,12 @@ class ConrodParams:
         ``I`` or ``H``.
     shank_fillet : float
         Inner web-to-flange fillet of the section, m (full only).
+    small_end_fillet : float
+        Transition fillet of the small-end eye to the shank, m (full only; 0: a sharp edge):
+        rounds the edges where the flanges' outer and side faces meet the eye's outer cylinder
+        (the section's inner faces stay sharp). Without it the peak stress at that edge grows
+        with mesh refinement (a re-entrant edge). Admissible: half to 0.9 times the flange
+        thickness (see :func:`~crankmodal.geometry.checks.check_conrod`).
     bolt_boss_width, bolt_boss_height : float
         Bolt bosses either side of the big end across the cap split (plane x = 0): extent
         along y beyond the eye's outer radius and along x (both sides of the split), m.
@@ -160,6 +166,7 @@ class ConrodParams:
     shank_flange_thickness: float = 0.007
     shank_section: str = "I"
     shank_fillet: float = 0.0
+    small_end_fillet: float = 0.0
     bolt_boss_width: float = 0.014
     bolt_boss_height: float = 0.030
     bolt_diameter: float = 0.010
