@@ -605,11 +605,14 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         # one BLAS thread for the small dense work of the loop (two were 5-7x slower); PARDISO
         # sets its own MKL threads per call
         with threadpool_limits(limits=1, user_api="blas"):
-            op, start = deflated(solve, lambda: rng.standard_normal(n), R0, MR0)
+            def fresh():
+                return rng.standard_normal(n)
+
+            op, start = deflated(solve, fresh, R0, MR0)
             main = run(op, k, start, n - R0.shape[1])
-            lam, X, _ = complete_modes(
-                solve, lambda: rng.standard_normal(n), M, run, sigma + 1.0 / main.theta,
-                main.vectors, main.m_vectors, sigma, k, kept=(R0, MR0) if R0.shape[1] else None)
+            lam, X, _ = complete_modes(solve, fresh, M, run, sigma + 1.0 / main.theta,
+                                       main.vectors, main.m_vectors, sigma, k,
+                                       kept=(R0, MR0) if R0.shape[1] else None)
         if deflate:
             lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
         backend_name = fac.name
