@@ -67,6 +67,26 @@ def test_modal_stage_writes_fixed_result_keys_and_a_vtu_with_one_array_per_mode(
     assert len(vtu.point_data) == 5 and vtu.cells[0].type == "tetra10"
 
 
+def test_a_band_reaching_above_the_modes_computed_is_flagged_as_incomplete(ctx):
+    """The modes are the lowest n_modes: above the highest there may be more inside the band."""
+    import warnings
+
+    from crankmodal.fem.assembly import ModelWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = modal_stage.run(modal_stage.validate({"n_modes": 3, "band": [10, 1e5]}, SCENE), ctx)
+    f3 = res["frequencies_hz"][-1]
+    assert res["band_complete"] is False
+    assert any(f"reach {f3:.1f} Hz, below the band's 100000 Hz" in w for w in res["warnings"])
+    assert any(issubclass(w.category, ModelWarning) for w in caught)
+    # a band whose top lies below the highest mode computed holds every mode inside it
+    res = modal_stage.run(modal_stage.validate({"n_modes": 3, "band": [10, 0.99 * f3]}, SCENE),
+                          ctx)
+    assert res["band_complete"] is True and not any("modal.band" in w for w in res["warnings"])
+    assert len(res["frequencies_in_band_hz"]) == 2
+
+
 def test_supported_modal_and_static_stages_from_scene_tables(ctx):
     res = modal_stage.run(modal_stage.validate(
         {"n_modes": 3, "supports": [{"box": [-1, 1e-9, -1, 1, -1, 1], "fix": "xyz"}]}, SCENE), ctx)

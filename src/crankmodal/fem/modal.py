@@ -74,6 +74,9 @@ class Modes:
         Peak resident memory, bytes.
     in_band : ndarray of bool or None
         Which elastic modes lie in the requested band.
+    band_complete : bool or None
+        Whether every mode of the band was computed: the highest computed mode reaches the
+        band's top (the modes are the lowest ``n_modes``; above the highest there may be more).
     """
 
     frequencies_hz: np.ndarray
@@ -92,6 +95,12 @@ class Modes:
     band: tuple | None = None
     n_solves: int = 0
     solve_time: float = 0.0
+
+    @property
+    def band_complete(self) -> bool | None:
+        if self.band is None:
+            return None
+        return bool(len(self.frequencies_hz)) and bool(self.frequencies_hz[-1] >= self.band[1])
 
     def to_dict(self) -> dict:
         out = {
@@ -115,6 +124,7 @@ class Modes:
         if self.band is not None:
             out["band_hz"] = list(self.band)
             out["frequencies_in_band_hz"] = self.frequencies_hz[self.in_band]
+            out["band_complete"] = self.band_complete
         return out
 
 

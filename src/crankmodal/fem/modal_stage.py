@@ -24,7 +24,8 @@ SCHEMA: dict[str, Field] = {
     "n_modes": Field("int", 12, "number of elastic (non-rigid) modes wanted", ge=1, le=500),
     "supports": Field("tables", [], "supports {box = [xmin, xmax, ymin, ymax, zmin, zmax], fix = 'xyz'} "
                       "or {region = name, fix = 'x'|'xy'|...|'radial'}; empty: free-free"),
-    "band": Field("floats", None, "analysis band [f_min, f_max], Hz (flags the modes inside)",
+    "band": Field("floats", None, "analysis band [f_min, f_max], Hz (flags the modes inside; "
+                  "warns when the modes computed stop below f_max)",
                   length=2, check=_band_check),
     "backend": BACKEND_FIELD,
     "tol": Field("float", 1e-6, "largest admissible eigen-residual and M-orthogonality defect",
@@ -70,6 +71,17 @@ def run(p: dict, ctx) -> dict:
         "peak_memory_bytes": mem.peak,
         "warnings": list(model.warnings),
     })
+    if p["band"] is not None and not modes.band_complete:
+        import warnings
+
+        from .assembly import ModelWarning
+
+        f_top = modes.frequencies_hz[-1]
+        text = (f"modal.band: the {len(modes.frequencies_hz)} modes computed reach {f_top:.1f} Hz, "
+                f"below the band's {p['band'][1]:g} Hz: modes between them were not computed; "
+                f"raise modal.n_modes")
+        warnings.warn(text, ModelWarning, stacklevel=2)
+        res["warnings"].append(text)
     if part.cad_mass is not None:
         cad = part.cad_mass.mass(mat.rho)
         res["mass_vs_cad"] = modes.total_mass / cad - 1.0
