@@ -84,3 +84,21 @@ def test_a_model_too_large_for_the_memory_stops_before_the_factorisation(cli, tm
     for f in ("modal: factorising", "GB", "coarser mesh", "CRANKMODAL_MEMORY_LIMIT"):
         assert f in error[0], error[0]
     assert not (tmp_path / "o" / "results.json").exists()
+
+
+def test_model_warnings_are_one_plain_line_and_land_in_the_results(cli, tmp_path):
+    """A band above the modes computed: the run succeeds and says so once, without Python's
+    source-line noise."""
+    import json
+
+    s = tmp_path / "s.toml"
+    s.write_text('[geometry]\nmachine = "four_star_compressor"\npart = "crankshaft"\n'
+                 'fidelity = "simplified"\nmesh_size = 0.03\nelement_order = 1\n'
+                 '[material]\nname = "steel"\n[modal]\nn_modes = 2\nband = [10.0, 1e5]\n')
+    proc = cli("run", s, "--out", tmp_path / "o", "--no-figures", warnings="default")
+    assert proc.returncode == 0, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.startswith("crankmodal: warning:")]
+    assert len(lines) == 1 and lines[0].startswith("crankmodal: warning: modal.band: the 2 modes")
+    assert "runner.py" not in proc.stderr
+    res = json.loads((tmp_path / "o" / "results.json").read_text())["modal"]
+    assert res["band_complete"] is False and res["warnings"][-1] in lines[0]

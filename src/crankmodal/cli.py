@@ -83,10 +83,27 @@ def _run(scene_file: Path, overrides, out: Path | None, figures: bool) -> int:
     return 0
 
 
+def _show_model_warnings():
+    """Print crankmodal's own model warnings as one plain line each (``crankmodal: warning:``);
+    other warnings keep Python's format, which names their source."""
+    import warnings
+
+    python_format = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if category.__name__ == "ModelWarning":
+            print(f"crankmodal: warning: {message}", file=sys.stderr)
+        else:
+            python_format(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``crankmodal`` console script; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
     debug = "--debug" in argv
+    _show_model_warnings()
     try:
         args = _parser().parse_args(argv)
         if args.command == "run":
