@@ -61,18 +61,23 @@ def test_debug_shows_the_traceback(cli, tmp_path):
     assert "Traceback" in proc.stderr
 
 
-def test_a_model_too_large_for_the_memory_stops_before_the_factorisation(cli, tmp_path, monkeypatch):
+def _bar_vtu(path, divisions=(10, 2, 2)):
+    """A P1 bar written as a mesh file, its tetrahedra positively oriented as a mesher's."""
     import meshio
     import numpy as np
 
     from crankmodal.fem.testparts import bar
 
-    part = bar(0.2, 0.02, 0.02, (10, 2, 2), order=1)
+    part = bar(0.2, 0.02, 0.02, divisions, order=1)
     p, cells = part.mesh.points, part.mesh.cells[0].data.copy()
     e = p[cells[:, 1:]] - p[cells[:, :1]]
     flip = np.einsum("ij,ij->i", np.cross(e[:, 0], e[:, 1]), e[:, 2]) < 0
-    cells[flip] = cells[flip][:, [0, 2, 1, 3]]  # positive volumes, as a mesher writes them
-    meshio.write(tmp_path / "bar.vtu", meshio.Mesh(part.mesh.points, [("tetra", cells)]))
+    cells[flip] = cells[flip][:, [0, 2, 1, 3]]
+    meshio.write(path, meshio.Mesh(part.mesh.points, [("tetra", cells)]))
+
+
+def test_a_model_too_large_for_the_memory_stops_before_the_factorisation(cli, tmp_path, monkeypatch):
+    _bar_vtu(tmp_path / "bar.vtu")
     s = tmp_path / "s.toml"
     s.write_text('[geometry]\nfile = "bar.vtu"\n[material]\nname = "steel"\n[modal]\nn_modes = 4\n')
     monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", "1e-6")  # 1 kB
@@ -102,3 +107,24 @@ def test_model_warnings_are_one_plain_line_and_land_in_the_results(cli, tmp_path
     assert "runner.py" not in proc.stderr
     res = json.loads((tmp_path / "o" / "results.json").read_text())["modal"]
     assert res["band_complete"] is False and res["warnings"][-1] in lines[0]
+
+
+def test_superlu_running_out_of_memory_is_one_error_line_not_a_killed_process(cli, tmp_path,
+                                                                             monkeypatch):
+    """SuperLU gives no estimate beforehand: it factorises under an address-space limit of what
+    is available, so running out is reported with advice (exit 2) and no result is written."""
+    _bar_vtu(tmp_path / "bar.vtu", (40, 8, 8))  # 8.7k DOF: a SuperLU factor of tens of MB
+    s = tmp_path / "s.toml"
+    s.write_text('[geometry]\nfile = "bar.vtu"\n[material]\nname = "steel"\n'
+                 '[modal]\nn_modes = 4\nbackend = "superlu"\n')
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", "0.001")  # 1 MB
+    proc = cli("run", s, "--out", tmp_path / "o")
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr
+    error = [line for line in proc.stderr.splitlines() if "error" in line]
+    assert len(error) == 1, proc.stderr
+    assert error[0].startswith("crankmodal: error: modal: factorising ") and \
+        "with SuperLU ran out of the 0.001 GB available: install pypardiso" in error[0]
+    assert not (tmp_path / "o" / "results.json").exists()
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", "20")  # the same run with room: fine
+    assert cli("run", s, "--out", tmp_path / "o").returncode == 0

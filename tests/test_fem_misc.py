@@ -141,3 +141,4 @@ def test_a_factor_larger_than_the_memory_is_refused_before_it_is_allocated(monke
         modal.solve_modes(model, 4)
     monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", str(2 * needed / 1e9))
     assert solvers.factorize(model.K + model.M, "pardiso").memory_needed == needed
+

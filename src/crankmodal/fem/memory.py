@@ -6,6 +6,7 @@ down, so a sampling thread records the largest resident set size seen during the
 
 from __future__ import annotations
 
+import contextlib
 import os
 import resource
 import threading
@@ -99,6 +100,37 @@ def available_bytes() -> int | None:
     if room is not None:
         avail = room if avail is None else min(avail, room)
     return avail
+
+
+
+@contextlib.contextmanager
+def address_space_limit(extra: int | None):
+    """Let the process map at most ``extra`` bytes more than it has mapped now (Linux).
+
+    Inside, an allocation beyond that fails with ``MemoryError`` instead of the kernel's
+    out-of-memory killer ending the process. Memory the process has mapped but freed (glibc's
+    heap) can be used on top: a safety net, not an exact bound. ``None``, or a system without
+    ``/proc/self/status``: no limit.
+    """
+    try:
+        with open("/proc/self/status") as fh:
+            vm = next(int(line.split()[1]) * 1024 for line in fh if line.startswith("VmSize:"))
+    except (OSError, StopIteration, ValueError):
+        vm = None
+    if extra is None or vm is None:
+        yield
+        return
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    limit = vm + int(extra)
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    if soft != resource.RLIM_INFINITY:
+        limit = min(limit, soft)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
 
 
 class PeakMemory:

@@ -88,14 +88,31 @@ def resolve_backend(backend: str) -> str:
 
 
 class SuperLUFactor:
-    """scipy SuperLU (COLAMD ordering) of a square sparse matrix."""
+    """scipy SuperLU (COLAMD ordering) of a square sparse matrix.
+
+    SuperLU cannot say beforehand how much memory its factor takes. Where the system tells what
+    is available (:func:`~crankmodal.fem.memory.available_bytes`), the factorisation runs under
+    an address-space limit of that much more than the process holds, so running out is a
+    ``MemoryError`` SuperLU reports, turned into :class:`ResourceError` — not the kernel killing
+    the run.
+    """
 
     name = "superlu"
 
-    def __init__(self, A):
+    def __init__(self, A, label: str = ""):
         from scipy.sparse.linalg import splu
 
-        self._lu = splu(sp.csc_matrix(A), permc_spec="COLAMD")
+        from .memory import address_space_limit, available_bytes
+
+        n, avail = A.shape[0], available_bytes()
+        try:
+            with address_space_limit(avail):
+                self._lu = splu(sp.csc_matrix(A), permc_spec="COLAMD")
+        except MemoryError:
+            raise ResourceError(
+                f"{label}factorising {n} unknowns with SuperLU ran out of the "
+                f"{avail / 1e9:.3g} GB available: install pypardiso (PARDISO needs a fraction of "
+                f"SuperLU's memory), or use a coarser mesh or element_order = 1") from None
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         return self._lu.solve(np.asarray(b, float))
@@ -253,7 +270,7 @@ def factorize(A, backend: str = "auto", positive_definite: bool = True, label: s
     name = resolve_backend(backend)
     if name == "pardiso":
         return PardisoFactor(A, positive_definite=positive_definite, label=label)
-    return SuperLUFactor(A)
+    return SuperLUFactor(A, label=label)
 
 
 def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_definite: bool = True,
@@ -275,7 +292,7 @@ def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_defini
             U -= sigma * upper_triangle(M)
         return PardisoFactor(U.tocsr(), positive_definite=positive_definite, upper=True,
                              label=label)
-    return SuperLUFactor(K - sigma * M)
+    return SuperLUFactor(K - sigma * M, label=label)
 
 
 def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
@@ -296,4 +313,4 @@ def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
     if resolve_backend(backend) == "pardiso":
         U = upper_triangle(K)[idx][:, idx]
         return PardisoFactor(U, positive_definite=positive_definite, upper=True, label=label)
-    return SuperLUFactor(sp.csr_matrix(K)[idx][:, idx])
+    return SuperLUFactor(sp.csr_matrix(K)[idx][:, idx], label=label)
