@@ -5,6 +5,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
+from crankmodal.errors import SceneError
 from crankmodal.fem.assembly import assemble, rigid_body_modes
 from crankmodal.fem.materials import Material
 from crankmodal.fem.modal import solve_modes
@@ -202,6 +203,16 @@ def test_cutoff_keeps_every_fixed_interface_mode_below_it(bar_model):
     cb = craig_bampton(model, itf, cutoff_hz=cut)
     assert cb.n_fixed_modes == 10
     assert np.allclose(cb.fixed_interface_hz, ref[:10], rtol=1e-9)
+
+
+def test_a_cutoff_beyond_the_most_modes_kept_is_refused_not_truncated(bar_model):
+    part, model = bar_model
+    itf = _ends(part, "rigid")
+    f10 = craig_bampton(model, itf, n_modes=10).fixed_interface_hz[-1]
+    with pytest.raises(SceneError, match=r"reduction.cutoff_hz: 10 fixed-interface modes .* "
+                                         r"reach only [\d.]+ Hz, below the cut-off"):
+        craig_bampton(model, itf, cutoff_hz=2 * f10, max_modes=10)
+    assert craig_bampton(model, itf, cutoff_hz=0.999 * f10, max_modes=10).n_fixed_modes == 9
 
 
 def test_fixed_interface_pairs_of_a_tube_are_both_kept_when_few_modes_are_asked():

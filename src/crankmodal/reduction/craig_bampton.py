@@ -306,13 +306,17 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     t0 = time.perf_counter()
     n_free = len(I) - len(drows)
     if cutoff_hz is not None:
-        k = min(20, n_free - 2)
+        k = min(20, max_modes, n_free - 2)
         while True:
             lam, X = _fixed_interface_modes(M_II, solver, len(I), k)
             f = np.sqrt(np.abs(lam)) / (2 * np.pi)
             if f.max() > cutoff_hz or k >= min(max_modes, n_free - 2):
                 break
             k = min(2 * k, max_modes, n_free - 2)
+        if f.max() <= cutoff_hz and k < n_free - 2:  # stopped at max_modes, not at the cut-off
+            raise SceneError(f"reduction.cutoff_hz: {k} fixed-interface modes (the most kept) "
+                             f"reach only {f.max():.6g} Hz, below the cut-off {cutoff_hz:g} Hz; "
+                             f"lower cutoff_hz or give n_modes")
         keep = f <= cutoff_hz
         lam, X = lam[keep], X[:, keep]
     elif n_modes > 0:
