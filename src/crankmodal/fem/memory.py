@@ -102,7 +102,6 @@ def available_bytes() -> int | None:
     return avail
 
 
-
 @contextlib.contextmanager
 def address_space_limit(extra: int | None):
     """Let the process map at most ``extra`` bytes more than it has mapped now (Linux).

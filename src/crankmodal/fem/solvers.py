@@ -109,10 +109,11 @@ class SuperLUFactor:
             with address_space_limit(avail):
                 self._lu = splu(sp.csc_matrix(A), permc_spec="COLAMD")
         except MemoryError:
+            room = "memory" if avail is None else f"the {avail / 1e9:.3g} GB available"
             raise ResourceError(
-                f"{label}factorising {n} unknowns with SuperLU ran out of the "
-                f"{avail / 1e9:.3g} GB available: install pypardiso (PARDISO needs a fraction of "
-                f"SuperLU's memory), or use a coarser mesh or element_order = 1") from None
+                f"{label}factorising {n} unknowns with SuperLU ran out of {room}: install "
+                f"pypardiso (PARDISO needs a fraction of SuperLU's memory), or use a coarser mesh "
+                f"or element_order = 1") from None
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         return self._lu.solve(np.asarray(b, float))
