@@ -57,6 +57,11 @@ def test_clamped_cantilever_first_bending_within_0p5_percent_of_timoshenko(bar_m
     # first cantilever mode carries 61.3 % of the mass in its direction (Euler-Bernoulli
     # 0.6131; shear and 3-D effects are < 1 % at L/h = 25)
     assert m.effective_mass[0, 2] / m.total_mass == pytest.approx(0.6131, rel=0.01)
+    # the first two z-bending modes together: 0.6131 + 0.1883 (Euler-Bernoulli)
+    cum = m.to_dict()["effective_mass_cumulative_fraction"]
+    assert cum["z"][-1] == pytest.approx(0.8014, rel=0.015)
+    assert np.all(np.diff(cum["z"]) >= 0) and cum["z"][-1] < 1
+    assert m.rigid_mass[:3] == pytest.approx([m.total_mass] * 3, rel=1e-12)
 
 
 def test_mass_matrix_integrates_to_exact_mass_and_inertia_of_a_bar(bar_model):

@@ -62,6 +62,10 @@ class Modes:
         the centre of mass (kg m²).
     total_mass : float
         kg, from M.
+    rigid_mass : ndarray, shape (6,) or None
+        What the six rigid-body fields carry (the totals the effective masses add up to over
+        every mode): mass along x, y, z (kg) and moments of inertia about the axes through the
+        centre of mass (kg m²).
     n_dofs : int
         Unconstrained degrees of freedom solved for.
     backend : str
@@ -95,6 +99,7 @@ class Modes:
     band: tuple | None = None
     n_solves: int = 0
     solve_time: float = 0.0
+    rigid_mass: np.ndarray | None = None
 
     @property
     def band_complete(self) -> bool | None:
@@ -121,6 +126,11 @@ class Modes:
             "timings_s": self.timings,
             "peak_memory_bytes": self.memory.get("peak_rss_bytes"),
         }
+        if self.rigid_mass is not None:  # cumulative share of the total, as modes are added
+            tot = np.where(self.rigid_mass > 0, self.rigid_mass, 1.0)
+            cum = np.cumsum(self.effective_mass, axis=0) / tot
+            out["effective_mass_cumulative_fraction"] = {
+                k: cum[:, i] for i, k in enumerate(("x", "y", "z", "rx", "ry", "rz"))}
         if self.band is not None:
             out["band_hz"] = list(self.band)
             out["frequencies_in_band_hz"] = self.frequencies_hz[self.in_band]
@@ -647,7 +657,9 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         shapes = T @ X
         mtot, c = mass_and_centre(model)
         R = rigid_body_modes(model.points, c)
-        gamma = shapes[:, n_rigid:].T @ (model.M @ R)
+        MR = model.M @ R
+        gamma = shapes[:, n_rigid:].T @ MR
+        rigid_mass = np.einsum("ij,ij->j", R, MR)  # m, m, m, Jxx, Jyy, Jzz about the centre
         timings["checks_s"] = time.perf_counter() - t0
     fe = f[n_rigid:]
     in_band = None
@@ -658,4 +670,4 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                  orthogonality=orth, effective_mass=gamma ** 2, total_mass=mtot, n_dofs=n,
                  backend=backend_name, timings=timings, memory=mem.to_dict(), in_band=in_band,
                  band=tuple(band) if band is not None else None, n_solves=n_solves[0],
-                 solve_time=solve_time[0])
+                 solve_time=solve_time[0], rigid_mass=rigid_mass)
