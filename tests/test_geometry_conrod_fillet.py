@@ -64,7 +64,6 @@ def fillet_volume_closed_form(p, R):
 def test_fillet_adds_the_closed_form_volume_of_its_corners_within_20_percent(R):
     added = cad_volume(dataclasses.replace(ROD, small_end_fillet=R)) - cad_volume(SHARP)
     expected = fillet_volume_closed_form(ROD, R)
-    print(f"R = {R * 1e3:.1f} mm: added {added * 1e9:.1f} mm3, closed form {expected * 1e9:.1f} mm3")
     assert added == pytest.approx(expected, rel=0.20)
 
 

@@ -174,8 +174,9 @@ def _fixed_interface_modes(M, solver, n, k):
     """Lowest ``k`` eigenpairs of (K, M) on ker G: shift-invert Lanczos about 0 with ``solver``.
 
     :func:`crankmodal.fem.modal.lanczos` (full reorthogonalisation, checked at every step), with
-    only the basis kept (not M times it: half the memory of the 150-step run 60 modes take).
-    Neither sorted nor normalised: :func:`crankmodal.fem.modal.sort_and_normalise` does that
+    only the basis kept (not M times it: half the memory of the 150-step run 60 modes take),
+    then :func:`crankmodal.fem.modal.complete_modes` (8 more solves) for the second mode of an
+    exactly repeated pair. Neither sorted nor normalised: :func:`crankmodal.fem.modal.sort_and_normalise` does that
     once the factor is freed (normalising here was the memory peak of a 274k-DOF reduction).
 
     At 255k P2 DOF (seed 000 crank, 9 interfaces) 60 modes took 153 solves: 28.6 s with
