@@ -33,8 +33,8 @@ def list_machines() -> list[str]:
     return sorted(names)
 
 
-def machine_path(name: str) -> Path:
-    """Path of the parameter file of machine ``name``.
+def machine_path(name: str, key: str = "machine") -> Path:
+    """Path of the parameter file of machine ``name``; ``key`` is the scene key naming it.
 
     Raises
     ------
@@ -46,7 +46,7 @@ def machine_path(name: str) -> Path:
         if p.is_file():
             return p
     known = ", ".join(list_machines()) or "none"
-    raise SceneError(f"machine: unknown machine {name!r}; known machines: {known}")
+    raise SceneError(f"{key}: unknown machine {name!r}; known machines: {known}")
 
 
 def load_toml(path: Path) -> dict:
@@ -63,9 +63,10 @@ def load_toml(path: Path) -> dict:
         raise InputFileError(f"{path}: cannot read: {exc.strerror}") from None
 
 
-def load_machine(name: str) -> dict:
-    """The parameter tables of machine ``name`` (SI units), as a dict of tables."""
-    return load_toml(machine_path(name))
+def load_machine(name: str, key: str = "machine") -> dict:
+    """The parameter tables of machine ``name`` (SI units), as a dict of tables; ``key`` is the
+    scene key naming it, for the error message."""
+    return load_toml(machine_path(name, key))
 
 
 def scene_path(name: str) -> Path:

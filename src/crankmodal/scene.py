@@ -143,7 +143,7 @@ def with_machine_defaults(section: str, table: dict) -> dict:
         return table
     if not isinstance(machine, str):
         raise SceneError(f"{section}.machine: must be a string, got {machine!r}")
-    tables = load_machine(machine)
+    tables = load_machine(machine, key=f"{section}.machine")
     defaults = tables.get(section)
     if defaults is None:
         return table

@@ -81,6 +81,8 @@ def _check_number(key: str, x: Any, f: Field) -> float:
     x = float(x) if f.type in ("float", "floats") else x
     if isinstance(x, float) and math.isnan(x):
         raise _fail(key, "must be a number, got nan")
+    if isinstance(x, float) and math.isinf(x):
+        raise _fail(key, f"must be a finite number, got {x!r}")
     for bound, op, text in (
         (f.gt, lambda a, b: a > b, ">"),
         (f.ge, lambda a, b: a >= b, ">="),

@@ -13,6 +13,9 @@ from .clearance import FILM_MODELS
 
 MECHANISMS = ("slider_crank", "four_star", "four_bar")
 METHODS = ("auto", "LSODA", "Radau", "BDF", "RK45", "DOP853")
+#: most output samples of one run (``end_time / output_step``): 1e7 samples of the history
+#: arrays already take gigabytes
+MAX_OUTPUT_SAMPLES = 10_000_000
 
 SCHEMA = {
     "machine": Field("str", None, "machine file whose [dynamics] table gives the defaults"),
@@ -230,3 +233,25 @@ def _cross_checks(p):
         raise SceneError("dynamics.ramp_time: must be 0 with drive_torque (the torque drives)")
     if p["ramp_time"] >= p["end_time"] and p["ramp_time"] > 0:
         raise SceneError(f"dynamics.ramp_time: must be < end_time ({p['end_time']:g} s)")
+    if p["spectrum_start"] is not None and p["spectrum_start"] >= p["end_time"]:
+        raise SceneError(f"dynamics.spectrum_start: must be < end_time ({p['end_time']:g} s), "
+                         f"got {p['spectrum_start']:g}")
+    dt = p["output_step"]
+    if dt is not None and not p["end_time"] / MAX_OUTPUT_SAMPLES <= dt <= p["end_time"]:
+        raise SceneError(f"dynamics.output_step: must be in [end_time / {MAX_OUTPUT_SAMPLES:.0e}, "
+                         f"end_time] = [{p['end_time'] / MAX_OUTPUT_SAMPLES:g}, "
+                         f"{p['end_time']:g}] s, got {dt:g}")
+
+
+def check_speed(p, speed_rpm: float, key: str = "dynamics.speed_rpm") -> None:
+    """Checks that need the crank speed (``key`` names where it was given, rpm)."""
+    limit = SCHEMA["speed_rpm"].le
+    if speed_rpm > limit:
+        raise SceneError(f"{key}: must be <= {limit:g} rpm for [dynamics], got {speed_rpm:g}")
+    s = p["solver"]
+    steps = 6.0 * speed_rpm * (p["end_time"] - p["ramp_time"]) / s["max_step_deg"]
+    if steps > s["max_rhs_evals"]:
+        raise SceneError(
+            f"dynamics.solver.max_step_deg: {s['max_step_deg']:g} deg needs at least {steps:.3g} "
+            f"steps at full speed, more than solver.max_rhs_evals = {s['max_rhs_evals']}; "
+            "raise max_step_deg or max_rhs_evals, or shorten end_time")

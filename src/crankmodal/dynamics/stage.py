@@ -16,11 +16,17 @@ REQUIRES = ()
 
 def validate(raw: dict, scene) -> dict:
     from ..errors import SceneError
-    from .scene_keys import validate_section
+    from .scene_keys import check_speed, validate_section
 
     p = validate_section(raw)
     if p["from_mechanism"] and (scene is None or "mechanism" not in scene.sections):
         raise SceneError("dynamics.from_mechanism: needs a [mechanism] section in the scene")
+    if p["speed_rpm"] is not None:
+        check_speed(p, p["speed_rpm"])
+    elif p["from_mechanism"]:  # [mechanism] has validated its own speed_rpm before this
+        speed = scene.sections["mechanism"].get("speed_rpm")
+        if isinstance(speed, (int, float)) and not isinstance(speed, bool):
+            check_speed(p, speed, "mechanism.speed_rpm")
     return p
 
 

@@ -59,7 +59,7 @@ def validate(raw: dict, scene) -> dict:
     if p["machine"] is not None:
         from ..resources import load_machine
 
-        tables = load_machine(p["machine"])
+        tables = load_machine(p["machine"], key="geometry.machine")
         if p["part"] not in tables:
             raise SceneError(f"geometry.part: machine {p['machine']!r} has no [{p['part']}] table; "
                              f"it has: {', '.join(sorted(tables))}")

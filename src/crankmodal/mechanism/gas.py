@@ -132,7 +132,9 @@ def four_stroke_pressure(
     a_z = rise_end + constant_pressure_duration
     x_z = motion(a_z, r, lam, 1.0).x
     p_c = intake_pressure * compression_ratio**compression_exponent
-    rise = p_c + (max_pressure - p_c) * x / x_rise
+    # a rise too short for the piston to move in floating point (rise_end < ~1e-8 rad) is a
+    # jump to pz at TDC, not 0/0
+    rise = p_c + (max_pressure - p_c) * (x / x_rise if x_rise > 0 else np.ones_like(x))
     expansion = max_pressure * ((s_c + x_z) / (s_c + x)) ** expansion_exponent
     compression = intake_pressure * ((s_c + s_p) / (s_c + x)) ** compression_exponent
     return np.select(

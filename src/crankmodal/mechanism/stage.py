@@ -64,8 +64,9 @@ CYLINDER = {
 GAS = {
     "model": Field("str", "none", "'none', 'compressor' or 'four_stroke'",
                    choices=("none", "compressor", "four_stroke")),
-    "compression_exponent": Field("float", 1.4, "polytropic exponent of compression", gt=1),
-    "expansion_exponent": Field("float", 1.4, "polytropic exponent of expansion", gt=1),
+    "compression_exponent": Field("float", 1.4, "polytropic exponent of compression", gt=1,
+                                  le=2),
+    "expansion_exponent": Field("float", 1.4, "polytropic exponent of expansion", gt=1, le=2),
     "pressure_coefficient": Field("float", 1.0, "compressor: lambda_p = ps'/ps = pd/pd'",
                                   gt=0, le=1),
     "valve_timing": Field("str", "pressure", "compressor: 'pressure' or 'seed' (fixed angles)",
@@ -112,11 +113,13 @@ def _validate_compressor(p: dict) -> None:
                 f"{key}.discharge_pressure: must exceed the suction pressure, got "
                 f"{c['discharge_pressure']:g} <= {c['suction_pressure']:g} Pa"
             )
-        c_max = 1.0 / ((pd / ps) ** (1.0 / g["expansion_exponent"]) - 1.0)
+        expansion = (pd / ps) ** (1.0 / g["expansion_exponent"]) - 1.0
+        c_max = 1.0 / expansion if expansion > 0 else math.inf  # ratio within rounding of 1
         if g["valve_timing"] == "pressure" and c["relative_clearance"] >= c_max:
             raise SceneError(
-                f"{key}.relative_clearance: must be < {c_max:.4g} for this pressure ratio "
-                "(the clearance gas would never re-expand to the suction pressure)"
+                f"{key}.relative_clearance: must be < {c_max:.4g} for the pressure ratio "
+                f"{pd / ps:.4g} (with gas.pressure_coefficient = {lp:g}; the clearance gas "
+                "would never re-expand to the suction pressure)"
             )
 
 
@@ -125,7 +128,10 @@ def _validate_four_stroke(p: dict) -> None:
     for name in ("intake_pressure", "max_pressure", "exhaust_pressure", "compression_ratio"):
         if g[name] is None:
             raise SceneError(f"mechanism.gas.{name}: is required with model = 'four_stroke'")
-    p_c = g["intake_pressure"] * g["compression_ratio"] ** g["compression_exponent"]
+    try:
+        p_c = g["intake_pressure"] * g["compression_ratio"] ** g["compression_exponent"]
+    except OverflowError:
+        p_c = math.inf
     if g["max_pressure"] < p_c:
         raise SceneError(
             f"mechanism.gas.max_pressure: must be >= the compression end pressure "
@@ -157,8 +163,9 @@ def validate(raw: dict, scene=None) -> dict:
             f"mechanism.rod_length: must be > crank_radius = {r:g} m for a full turn, got {length:g}"
         )
     if p["rod_cg_from_big_end"] > length:
+        rule = "rod_length" if p["rod_length"] is not None else "crank_radius / rod_ratio"
         raise SceneError(
-            f"mechanism.rod_cg_from_big_end: must be <= the rod length {length:g} m, "
+            f"mechanism.rod_cg_from_big_end: must be <= the rod length {rule} = {length:g} m, "
             f"got {p['rod_cg_from_big_end']:g}"
         )
     if p["harmonics"] == "series" and p["max_order"] > 2:

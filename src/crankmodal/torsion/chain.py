@@ -58,7 +58,7 @@ class TorsionalChain:
         for name, arr in (("inertias", self.inertias), ("stiffnesses", self.stiffnesses)):
             for i, v in enumerate(arr):
                 if not (np.isfinite(v) and v > 0.0):
-                    raise SceneError(f"{self.key}.{name}[{i}]: must be > 0 and finite, got {v!r}")
+                    raise SceneError(f"{self.key}.{name}[{i}]: must be > 0 and finite, got {float(v)!r}")
         if len(self.stiffnesses) != need:
             raise SceneError(
                 f"{self.key}.stiffnesses: needs {need} entries for {n} inertias "

@@ -1,0 +1,299 @@
+"""Mutation fuzz of bad-input handling: one scene key at a time, through the CLI.
+
+Every ready scene is read, every key of its sections (nested tables, arrays of tables, the machine
+defaults a ``machine = ...`` section pulls in, a geometry part's machine table) is mutated alone
+with ``--set`` (wrong type, 0, negative, nan/inf, huge, tiny, empty or wrong-length list, an
+unknown sibling key), and the CLI must answer as the README promises: exit 0, or exit 2 with one
+line ``crankmodal: error: ...`` naming the key, never a traceback. On the cheap scenes (mechanism
+and torsion only, no gmsh) a sample of the mutations that pass ``check`` is also run: exit 0, 2 or
+3, one error line, and ``results.json`` complete and finite, or absent.
+
+The default run checks a fixed-seed sample; ``-m slow`` sweeps every mutation.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import random
+import re
+import warnings
+
+import pytest
+from conftest import SCENES
+
+from crankmodal import cli
+from crankmodal.resources import load_machine
+from crankmodal.scene import load_scene
+
+SCENE_FILES = sorted(SCENES.glob("*.toml"))
+#: scenes whose stages compute in well under a second without gmsh/scikit-fem
+CHEAP_SCENES = ("four_star_mechanism", "slider_crank_engine", "torsion_chain", "seed004_torsion")
+N_CHECK = 40  # sampled check mutations per scene (default run)
+N_RUN = 8     # sampled run mutations per cheap scene (default run)
+SEED = 20240607
+PROGRESS = re.compile(r"\[\w+\] (running|done in [0-9.]+ s)$")  # run's log lines
+
+
+def toml_value(v) -> str:
+    """``v`` in TOML syntax, as ``--set`` reads it."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + " }"
+    return "[" + ", ".join(toml_value(x) for x in v) + "]"
+
+
+def leaves(node, path=()):
+    """(path, value) of every key below ``node``, and (path + ('fuzz_unknown',), None) per table."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield from leaves(v, (*path, k))
+        yield (*path, "fuzz_unknown"), None
+    elif isinstance(node, list) and node and all(isinstance(x, dict) for x in node):
+        for i, v in enumerate(node):
+            yield from leaves(v, (*path, str(i)))
+    else:
+        yield path, node
+
+
+def mutations_of(value) -> list[str]:
+    """TOML texts of the bad (or merely unusual) values tried in place of ``value``."""
+    out = ['"fuzz"' if not isinstance(value, str) else "1.5", "{ a = 1 }", "[1.0, 2.0]", "0", "-1",
+           "nan", "inf", "-inf", "1e30", "1e-30", "[]", "true", '""']
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and value:
+        out.append(toml_value(-abs(value)))
+    if isinstance(value, list) and value:
+        out += [toml_value(value + value[-1:]), toml_value(value[:-1])]
+    return out
+
+
+def element_mutations(path, value):
+    """Mutations of single entries of a list of numbers or strings (``key.i=...``)."""
+    for i in range(len(value)):
+        for m in ("nan", "inf", "-1", "0", '"fuzz"', "[]"):
+            yield (*path, str(i)), m
+
+
+def scene_mutations(scene_file) -> list[tuple[str, str]]:
+    """Every (dotted key, TOML value) mutation of a scene, in a stable order."""
+    scene = load_scene(scene_file)
+    out = [("fuzz_section.key", "1")]
+    tables = dict(scene.sections)
+    geo = tables.get("geometry", {})
+    if isinstance(geo.get("machine"), str):  # the part's machine table, reachable as params
+        part = load_machine(geo["machine"]).get(geo.get("part", "crankshaft"), {})
+        tables["geometry"] = {**geo, "params": {**part, **geo.get("params", {})}}
+    for path, value in leaves(tables):
+        key = ".".join(path)
+        if value is None:
+            out.append((key, "1"))
+            continue
+        out += [(key, m) for m in mutations_of(value)]
+        if isinstance(value, list) and value and not isinstance(value[0], dict):
+            out += [(".".join(p), m) for p, m in element_mutations(path, value)]
+    return out
+
+
+def display_key(dotted: str) -> str:
+    """``dynamics.clearances.0.clearance`` -> ``dynamics.clearances[0].clearance``."""
+    parts = dotted.split(".")
+    text = parts[0]
+    for p in parts[1:]:
+        text += f"[{p}]" if p.isdigit() else f".{p}"
+    return text
+
+
+def run_in_process(*argv) -> tuple[int, str]:
+    """``crankmodal ARGV`` in this process: (exit status, stderr); an escaping exception is raised.
+
+    Warnings are ignored as :func:`conftest.run_cli` does, so stderr holds only the error path."""
+    err = io.StringIO()
+    show = warnings.showwarning
+    try:
+        with warnings.catch_warnings(), contextlib.redirect_stderr(err), \
+                contextlib.redirect_stdout(io.StringIO()):
+            warnings.simplefilter("ignore")
+            status = cli.main([str(a) for a in argv])
+    finally:
+        warnings.showwarning = show  # main() installs its own formatter
+    return status, err.getvalue()
+
+
+def error_problem(status, stderr, key, value, allowed=(0, 2)) -> str | None:
+    """What is wrong with a CLI answer to ``--set key=value``, or None."""
+    if status not in allowed:
+        return f"exit {status}: {stderr.strip()}"
+    if "Traceback" in stderr:
+        return f"traceback: {stderr}"
+    lines = [s for s in stderr.strip().splitlines() if not PROGRESS.match(s)]
+    if status == 0:
+        return None if not lines else f"exit 0 with stderr {stderr.strip()!r}"
+    if len(lines) != 1 or not lines[0].startswith("crankmodal: error: "):
+        return f"not one error line: {stderr!r}"
+    shown = display_key(key)
+    named = shown.rsplit("[", 1)[0] if shown.endswith("]") else shown  # a list, for an entry
+    table = named.rsplit(".", 1)[0] + "."
+    leaf = [p for p in key.split(".") if not p.isdigit()][-1]
+    section = key.split(".")[0]
+    line = lines[0]
+    if named in line or (leaf in line and section in line):
+        return None
+    if table.count(".") > 1 and table in line and status == 2:
+        return None  # a relation between two keys of one table, reported at the other key
+    if section == "fuzz_section" and f"[{section}]: unknown section" in line:
+        return None
+    return f"error does not name {shown}: {line}"
+
+
+def check_problem(scene_file, key, value):
+    try:
+        status, stderr = run_in_process("check", scene_file, "--set", f"{key}={value}")
+    except Exception as exc:  # noqa: BLE001 - an escaping exception is the defect reported
+        return f"{type(exc).__name__} escaped: {exc}"
+    return error_problem(status, stderr, key, value)
+
+
+def strict_json(path):
+    """Parse results.json refusing NaN and Infinity."""
+    def refuse(name):
+        raise ValueError(f"non-finite {name} in {path}")
+
+    return json.loads(path.read_text(), parse_constant=refuse)
+
+
+def run_problem(scene_file, key, value, out):
+    try:
+        status, stderr = run_in_process("run", scene_file, "--set", f"{key}={value}",
+                                        "--out", out, "--no-figures")
+    except Exception as exc:  # noqa: BLE001
+        return f"{type(exc).__name__} escaped: {exc}"
+    problem = error_problem(status, stderr, key, value, allowed=(0, 2, 3))
+    if problem and status == 3 and "not name" in problem:
+        problem = None  # a numerical failure names what failed, not necessarily the key
+    results = out / "results.json"
+    if status == 0:
+        try:
+            strict_json(results)
+        except (OSError, ValueError) as exc:
+            return f"exit 0 but results.json bad: {exc}"
+    elif results.exists():
+        return f"exit {status} but results.json written"
+    if list(out.glob(".results.json.*")):
+        return "temporary results file left behind"
+    return problem
+
+
+def sample(items, n, salt):
+    return sorted(random.Random(f"{SEED}:{salt}").sample(items, min(n, len(items))))
+
+
+def _check_all(scene_file, items):
+    problems = [f"--set {k}={v}: {p}" for k, v in items
+                if (p := check_problem(scene_file, k, v)) is not None]
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("scene_file", SCENE_FILES, ids=lambda p: p.stem)
+def test_check_rejects_mutated_keys_with_one_line_naming_the_key(scene_file):
+    _check_all(scene_file, sample(scene_mutations(scene_file), N_CHECK, scene_file.stem))
+
+
+def _passing_mutations(scene_file):
+    return [(k, v) for k, v in scene_mutations(scene_file)
+            if run_in_process("check", scene_file, "--set", f"{k}={v}")[0] == 0]
+
+
+def _run_all(scene_file, items, tmp_path):
+    problems = []
+    for i, (k, v) in enumerate(items):
+        p = run_problem(scene_file, k, v, tmp_path / f"out{i}")
+        if p is not None:
+            problems.append(f"--set {k}={v}: {p}")
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("name", CHEAP_SCENES)
+def test_run_of_mutations_that_pass_check_ends_cleanly(name, tmp_path):
+    scene_file = SCENES / f"{name}.toml"
+    _run_all(scene_file, sample(_passing_mutations(scene_file), N_RUN, name), tmp_path)
+
+
+def test_in_process_answer_is_the_console_scripts(cli):
+    """The in-process entry sees what a user sees: same status and error line as a subprocess."""
+    scene_file = SCENES / "torsion_chain.toml"
+    argv = ("check", scene_file, "--set", "torsion.inertias.1=nan")
+    status, stderr = run_in_process(*argv)
+    proc = cli(*argv)
+    assert (status, stderr) == (proc.returncode, proc.stderr)
+    assert status == 2 and "torsion.inertias[1]" in stderr
+
+
+# Defects the sweep found, one each: (scene, --set, exit status of check, fragment of the line).
+FOUND = [
+    ("torsion_chain", "torsion.operating_speed_rpm=inf", 2,
+     "torsion.operating_speed_rpm: must be a finite number, got inf"),  # was exit 3 at run
+    ("seed004_torsion", "torsion.G=inf", 2, "torsion.G: must be a finite number"),  # blamed
+    # torsion.stiffnesses[0], a key the scene does not have
+    ("slider_crank_engine", "mechanism.gas.compression_exponent=1e30", 2,
+     "mechanism.gas.compression_exponent: must be <= 2"),  # was an OverflowError traceback
+    ("four_star_mechanism", "mechanism.gas.expansion_exponent=10", 2,
+     "mechanism.gas.expansion_exponent: must be <= 2"),  # 1e30: a ZeroDivisionError traceback
+    ("four_star_mechanism", 'mechanism.machine="v12"', 2,
+     "mechanism.machine: unknown machine 'v12'"),  # was "machine: ..."
+    ("seed000_rod_static", 'geometry.machine="v12"', 2, "geometry.machine: unknown machine"),
+    ("slider_crank_engine", "mechanism.crank_radius=1e-30", 2,
+     "rod length crank_radius / rod_ratio = 3.33333e-30 m"),
+    ("four_star_mechanism", "mechanism.gas.pressure_coefficient=1e-30", 2,
+     "with gas.pressure_coefficient = 1e-30"),
+    ("slider_crank_dynamics", "dynamics.output_step=1e-30", 2,
+     "dynamics.output_step: must be in [end_time / 1e+07, end_time]"),  # arange traceback
+    ("slider_crank_dynamics", "dynamics.spectrum_start=1e30", 2,
+     "dynamics.spectrum_start: must be < end_time"),  # a traceback after the integration
+    ("slider_crank_dynamics", "dynamics.solver.max_step_deg=1e-30", 2,
+     "dynamics.solver.max_step_deg: 1e-30 deg needs at least"),  # ran past the time limit
+    ("slider_crank_dynamics", "mechanism.speed_rpm=1e30", 2,
+     "mechanism.speed_rpm: must be <= 20000 rpm for [dynamics]"),  # arange traceback
+    ("slider_crank_engine", "mechanism.gas.rise_end_deg=1e-30", 0, ""),  # run: NaN, exit 3
+]
+
+
+@pytest.mark.parametrize("name, assignment, status, fragment", FOUND,
+                         ids=[a.split("=")[0] for _, a, _, _ in FOUND])
+def test_found_defects_stay_fixed(name, assignment, status, fragment, tmp_path):
+    scene_file = SCENES / f"{name}.toml"
+    got, stderr = run_in_process("check", scene_file, "--set", assignment)
+    assert got == status and fragment in stderr, stderr
+    if name in CHEAP_SCENES and status == 0:
+        key, _, value = assignment.partition("=")
+        assert run_problem(scene_file, key, value, tmp_path / "out") is None
+        peak = strict_json(tmp_path / "out" / "results.json")["mechanism"]["peak_gas_force_n"]
+        # an instant rise still reaches pz (held 5 deg): (pz - p_crankcase) pi D^2 / 4
+        assert peak[0] == pytest.approx((6.5e6 - 1.0e5) * math.pi * 0.086**2 / 4, rel=1e-12)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene_file", SCENE_FILES, ids=lambda p: p.stem)
+def test_check_every_mutation(scene_file):
+    _check_all(scene_file, scene_mutations(scene_file))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", CHEAP_SCENES)
+def test_run_every_mutation_that_passes_check(name, tmp_path):
+    scene_file = SCENES / f"{name}.toml"
+    _run_all(scene_file, _passing_mutations(scene_file), tmp_path)
+
+
+def test_mutation_values_are_valid_toml():
+    import tomllib
+
+    for v in mutations_of([1.0, 2.5]) + mutations_of("x") + mutations_of(3):
+        tomllib.loads(f"v = {v}")
+    assert math.isnan(tomllib.loads("v = nan")["v"])
