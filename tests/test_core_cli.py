@@ -55,10 +55,83 @@ def test_usage_errors(cli, argv):
     assert_clean_error(cli(*argv), "usage:")
 
 
-def test_debug_shows_the_traceback(cli, tmp_path):
-    proc = cli("--debug", "run", tmp_path / "missing.toml")
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_shows_the_traceback(cli, tmp_path, where):
+    """``--debug`` before or after the command; after it, the command's default must not undo a
+    ``--debug`` given before it."""
+    bad = ["run", tmp_path / "missing.toml"]
+    proc = cli(*(["--debug", *bad] if where == "before" else [*bad, "--debug"]))
     assert proc.returncode != 0
-    assert "Traceback" in proc.stderr
+    assert "Traceback" in proc.stderr and "file not found" in proc.stderr
+
+
+TORSION = "[torsion]\ninertias = [0.3, 0.6]\nstiffnesses = [1.32e5]\n"
+IMPOSSIBLE = ("--set", "torsion.inertias=[-1, 0.6]")
+
+
+def test_a_failed_run_removes_the_results_of_an_earlier_run(cli, tmp_path):
+    """SCENES.md: bad input leaves no results.json, also not the one of an earlier good run
+    in the same --out folder; nothing else there is touched."""
+    import json
+
+    s = tmp_path / "s.toml"
+    s.write_text(TORSION)
+    out = tmp_path / "o"
+    good = cli("run", s, "--out", out, "--no-figures")
+    assert good.returncode == 0, good.stderr
+    assert json.loads((out / "results.json").read_text())["scene"] == "s"
+    others = sorted(f.name for f in out.iterdir() if f.name != "results.json")
+    assert others  # the torsion stage writes its tables next to results.json
+    assert_clean_error(cli("run", s, "--out", out, *IMPOSSIBLE), "torsion.inertias[0]", "> 0")
+    assert not (out / "results.json").exists()
+    assert sorted(f.name for f in out.iterdir()) == others
+
+
+def test_a_failed_run_removes_the_results_in_the_default_folder(cli, tmp_path, monkeypatch):
+    """Default folder out/<name key>; a scene that does not parse falls back to its file stem.
+    Results in other folders are not touched."""
+    monkeypatch.chdir(tmp_path)
+    s = tmp_path / "s.toml"
+    s.write_text('name = "chain"\n' + TORSION)
+    assert cli("run", s, "--no-figures").returncode == 0
+    results = tmp_path / "out" / "chain" / "results.json"
+    assert results.is_file()
+    bystander = tmp_path / "out" / "s" / "results.json"  # the stem's folder: not this scene's
+    bystander.parent.mkdir()
+    bystander.write_text("{}")
+    assert_clean_error(cli("run", s, *IMPOSSIBLE), "torsion.inertias[0]")
+    assert not results.exists() and bystander.exists()
+
+    s.write_text("[torsion\n")  # no name to read: out/<stem> is the folder
+    assert_clean_error(cli("run", s), "invalid TOML")
+    assert not bystander.exists()
+
+
+def test_an_unparsable_scene_removes_the_results_in_the_out_folder(cli, tmp_path):
+    s = tmp_path / "s.toml"
+    s.write_text("[torsion\n")
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "results.json").write_text("{}")
+    (out / "torsion.png").write_text("")
+    assert_clean_error(cli("run", s, "--out", out), "invalid TOML")
+    assert sorted(f.name for f in out.iterdir()) == ["torsion.png"]
+
+
+@pytest.mark.parametrize("command", [["demo"], ["study", "simplification", "SCENE"]])
+def test_failed_demo_and_study_remove_their_stale_summary(cli, tmp_path, command):
+    """``demo`` writes results.json, ``study`` study.json: a failure removes that file only."""
+    from crankmodal.resources import scene_path
+
+    summary = "study.json" if command[0] == "study" else "results.json"
+    command = [scene_path("seed000_crank_study") if c == "SCENE" else c for c in command]
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / summary).write_text("{}")
+    (out / "keep.csv").write_text("")
+    proc = cli(*command, "--out", out, "--set", "modal.n_modes=-1")
+    assert_clean_error(proc, "modal.n_modes", ">= 1")
+    assert sorted(f.name for f in out.iterdir()) == ["keep.csv"]
 
 
 def _bar_vtu(path, divisions=(10, 2, 2)):

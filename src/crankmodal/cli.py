@@ -25,6 +25,11 @@ def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="crankmodal", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"crankmodal {__version__}")
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    # --debug is also accepted after the command; SUPPRESS keeps a subcommand that was not given
+    # it from overwriting the top-level value.
+    debug = argparse.ArgumentParser(add_help=False)
+    debug.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                       help="show tracebacks of errors")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     def scene_args(sp, scene_required=True):
@@ -35,27 +40,29 @@ def _parser() -> argparse.ArgumentParser:
             help="override a scene value (TOML syntax; repeatable)",
         )
 
-    r = sub.add_parser("run", help="run a scene, write DIR/results.json and figures")
+    r = sub.add_parser("run", parents=[debug],
+                       help="run a scene, write DIR/results.json and figures")
     scene_args(r)
     r.add_argument("--out", type=Path, help="output folder (default out/<scene name>)")
     r.add_argument("--no-figures", action="store_true", help="skip PNG plots")
 
-    c = sub.add_parser("check", help="validate a scene without running it")
+    c = sub.add_parser("check", parents=[debug], help="validate a scene without running it")
     scene_args(c)
 
-    d = sub.add_parser("demo", help="run the main job: the four-star compressor study")
+    d = sub.add_parser("demo", parents=[debug],
+                       help="run the main job: the four-star compressor study")
     scene_args(d, scene_required=False)
     d.add_argument("--out", type=Path, help="output folder (default out/four_star_compressor)")
     d.add_argument("--no-figures", action="store_true", help="skip PNG plots")
 
-    st = sub.add_parser("study", help="run a study of a scene's part (see README)")
+    st = sub.add_parser("study", parents=[debug], help="run a study of a scene's part (see README)")
     st.add_argument("kind", choices=("simplification",),
                     help="simplification: fidelities x mesh sizes x element orders")
     scene_args(st)
     st.add_argument("--out", type=Path, help="output folder (default out/<scene name>_study)")
     st.add_argument("--no-figures", action="store_true", help="skip PNG plots")
 
-    sub.add_parser("machines", help="list the machine parameter files")
+    sub.add_parser("machines", parents=[debug], help="list the machine parameter files")
     return p
 
 
@@ -83,6 +90,37 @@ def _run(scene_file: Path, overrides, out: Path | None, figures: bool) -> int:
     return 0
 
 
+#: command -> (the summary file it writes, suffix of its default folder ``out/<scene name>``)
+SUMMARY_FILES = {"run": ("results.json", ""), "demo": ("results.json", ""),
+                 "study": ("study.json", "_study")}
+
+
+def _remove_stale_summary(args) -> None:
+    """After a failed ``run``/``demo``/``study``, delete the summary file (``results.json``,
+    ``study.json``) that an earlier run left in the output folder, so that no old result looks
+    like the answer to this run. Nothing else is deleted, and no folder is created."""
+    if args.command not in SUMMARY_FILES:
+        return
+    filename, suffix = SUMMARY_FILES[args.command]
+    out_dir = args.out
+    if out_dir is None:  # the default folder out/<scene name><suffix>, as _run/study name it
+        from .resources import load_toml, scene_path
+
+        demo = args.command == "demo"
+        stem = DEMO_SCENE if demo else Path(args.scene).stem
+        try:
+            name = load_toml(scene_path(DEMO_SCENE) if demo else args.scene).get("name")
+        except CrankmodalError:
+            # A missing or unparsable file: its stem, the name of a scene without a `name`
+            # key, is the best guess.
+            name = None
+        out_dir = Path("out") / ((name if isinstance(name, str) else stem) + suffix)
+    try:
+        (Path(out_dir) / filename).unlink(missing_ok=True)
+    except OSError:  # e.g. DIR is a file: there is no stale summary to remove
+        pass
+
+
 def _show_model_warnings():
     """Print crankmodal's own model warnings as one plain line each (``crankmodal: warning:``);
     other warnings keep Python's format, which names their source."""
@@ -102,10 +140,12 @@ def _show_model_warnings():
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``crankmodal`` console script; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
-    debug = "--debug" in argv
+    debug = "--debug" in argv  # until the arguments have parsed
+    args = None
     _show_model_warnings()
     try:
         args = _parser().parse_args(argv)
+        debug = args.debug
         if args.command == "run":
             return _run(args.scene, args.overrides, args.out, not args.no_figures)
         if args.command == "demo":
@@ -137,6 +177,8 @@ def main(argv: list[str] | None = None) -> int:
             print("\n".join(list_machines()))
             return 0
     except CrankmodalError as exc:
+        if args is not None:
+            _remove_stale_summary(args)
         if debug:
             raise
         print(f"crankmodal: error: {exc}", file=sys.stderr)
