@@ -72,7 +72,7 @@ def test_a_band_reaching_above_the_modes_computed_is_flagged_as_incomplete(ctx):
     """The modes are the lowest n_modes: above the highest there may be more inside the band."""
     import warnings
 
-    from crankmodal.fem.assembly import ModelWarning
+    from crankmodal.errors import ModelWarning
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -33,3 +33,9 @@ class NumericalError(CrankmodalError):
     """A computation did not meet its own accuracy checks; the message says what to change."""
 
     exit_code = 3
+
+
+class ModelWarning(UserWarning):
+    """A model that will compute, but whose answer deserves suspicion (locking, units, impacts
+    shorter than the output step). The CLI prints it as one ``crankmodal: warning:`` line and the
+    stage keeps it in its ``warnings`` in results.json."""

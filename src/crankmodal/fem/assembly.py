@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import GeometryError
+from ..errors import GeometryError, ModelWarning
 from .memory import release_free_heap
 
 
@@ -61,10 +61,6 @@ class FEModel:
     @property
     def n_elements(self) -> int:
         return len(self.cells)
-
-
-class ModelWarning(UserWarning):
-    """A model that will compute, but whose answer deserves suspicion (locking, units)."""
 
 
 #: Poisson's ratio from which K's condition number (∝ bulk/shear modulus) is worth a warning

@@ -74,7 +74,7 @@ def run(p: dict, ctx) -> dict:
     if p["band"] is not None and not modes.band_complete:
         import warnings
 
-        from .assembly import ModelWarning
+        from ..errors import ModelWarning
 
         f_top = modes.frequencies_hz[-1]
         text = (f"modal.band: the {len(modes.frequencies_hz)} modes computed reach {f_top:.1f} Hz, "
