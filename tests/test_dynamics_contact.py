@@ -188,3 +188,22 @@ def test_impact_statistics_counts_a_bouncing_ball_by_velocity_and_by_flight_time
     st = impact_statistics(onsets, seps, min_flight=tau)
     assert st["impact_count"] == k_f
     assert st["impact_velocity_mean"] == pytest.approx(np.mean(v[:k_f]))
+
+
+def test_the_deepest_point_of_an_impact_is_an_event_however_coarse_the_output():
+    # Oracle: Hertz d_max = (5 m v0^2 / 4 K)^(2/5), peak force K d_max^1.5. Only the start is
+    # sampled, so no sample sees a contact; the events find each contact's deepest point.
+    K, v0 = 1e10, 1.0
+    sysm, joint = _journal_in_bearing("hertz", {"stiffness": K, "exponent": 1.5})
+    out = integrate(sysm, np.zeros(3), np.array([v0, 0.0, 0.0]), 3e-3, np.array([0.0]),
+                    SolverSettings(rtol=1e-9, atol=1e-13))
+    d_max = (2.5 * MASS * v0**2 / (2 * K)) ** 0.4
+    assert out.t.size == 1
+    peaks = out.peaks[0]
+    assert len(peaks) == len(out.onsets[0]) >= 2  # one deepest point per contact
+    for _, y in peaks:
+        k = joint.kinematics(sysm, y[:3], y[3:6])
+        assert k["delta"] == pytest.approx(d_max, rel=1e-6)
+        assert abs(k["delta_dot"]) < 1e-6 * v0
+        assert contact.normal_force("hertz", k["delta"], k["delta_dot"], joint.law_params,
+                                    v0) == pytest.approx(K * d_max**1.5, rel=2e-6)

@@ -41,6 +41,9 @@ class History:
     onsets : dict joint -> [(t, v_impact)] contact onsets (s, m/s), every zero crossing.
     separations : dict joint -> [t] contact separations, s.
     angular_acceleration : dict body name -> (K,) rad/s^2 (e.g. the loom's rocker and sley).
+    peaks : dict joint -> dict of arrays at the deepest penetration of each contact (located as
+        events, not sampled): ``t`` (s), ``fn`` (N), ``penetration`` (m), ``main_bearing_force``
+        (magnitude, N) and ``piston_acceleration`` (n, P) (m/s^2) at that instant.
     """
 
     t: np.ndarray
@@ -60,6 +63,7 @@ class History:
     onsets: dict = field(default_factory=dict)
     separations: dict = field(default_factory=dict)
     angular_acceleration: dict = field(default_factory=dict)
+    peaks: dict = field(default_factory=dict)
     nfev: int = 0
     wall_time: float = 0.0
 
@@ -88,7 +92,22 @@ class History:
             out[f"angular_acceleration_{name}"] = v
         for name, ev in self.onsets.items():
             out[f"impacts_{name}"] = np.asarray(ev, float).reshape(-1, 2)
+        for name, pk in self.peaks.items():
+            for k, v in pk.items():
+                out[f"peaks_{name}_{k}"] = v
         return out
+
+    def peak(self, key: str, sampled, name: str | None = None):
+        """Largest magnitude of a sampled quantity and of its values at the contacts' deepest
+        points (``key`` of :attr:`peaks`; every joint's, or joint ``name``'s).
+
+        ``sampled`` of shape (K,) gives a float; of shape (K, P), one peak per column.
+        """
+        sampled = np.abs(np.asarray(sampled, float))
+        parts = [sampled] + [np.abs(pk[key]).reshape((len(pk["t"]),) + sampled.shape[1:])
+                             for j, pk in self.peaks.items() if name is None or j == name]
+        out = np.max(np.concatenate(parts), axis=0, initial=0.0)
+        return float(out) if out.ndim == 0 else out
 
 
 def record(mech, sysm, integ) -> History:
@@ -116,9 +135,7 @@ def record(mech, sysm, integ) -> History:
     alpha = {b.name: np.zeros(K) for b in sysm.bodies if b.ndof == 3}
     for k in range(K):
         q, qd = integ.y[:n, k], integ.y[n:2 * n, k]
-        for cj, ons in zip(sysm.clearances, integ.onsets):  # the contact in progress
-            cj.v_impact = _impact_velocity(ons, integ.t[k], cj)
-        out = sysm.solve(integ.t[k], q, qd)
+        out = _solve_at(sysm, integ, integ.t[k], q, qd)
         qdd, lam = out["qdd"], out["lam"]
         for i, sl in enumerate(piston_sl):
             u = mech.axes[i]
@@ -173,7 +190,45 @@ def record(mech, sysm, integ) -> History:
                    constraint_drift=drift, angular_acceleration=alpha,
                    onsets={cj.name: integ.onsets[i] for i, cj in enumerate(sysm.clearances)},
                    separations={cj.name: integ.separations[i]
-                                for i, cj in enumerate(sysm.clearances)})
+                                for i, cj in enumerate(sysm.clearances)},
+                   peaks=_record_peaks(mech, sysm, integ, pins))
+
+
+def _solve_at(sysm, integ, t, q, qd) -> dict:
+    """``sysm.solve`` at one state, with each clearance joint's contact in progress."""
+    for cj, ons in zip(sysm.clearances, integ.onsets):
+        cj.v_impact = _impact_velocity(ons, t, cj)
+    return sysm.solve(t, q, qd)
+
+
+def _record_peaks(mech, sysm, integ, pins) -> dict:
+    """Contact force, main-bearing force and piston accelerations at each contact's deepest
+    penetration (the integrator's ``peak`` events)."""
+    n = sysm.n
+    rows = {c.name: r for c, r in pins}
+    names = [cj.name for cj in sysm.clearances]
+    piston_sl = [sysm.slices[id(p)] for p in mech.pistons]
+    out = {}
+    for j, cj in enumerate(sysm.clearances):
+        ev = integ.peaks[j] if j < len(integ.peaks) else []
+        d = {"t": np.zeros(len(ev)), "fn": np.zeros(len(ev)), "penetration": np.zeros(len(ev)),
+             "main_bearing_force": np.zeros(len(ev)),
+             "piston_acceleration": np.zeros((len(ev), len(piston_sl)))}
+        for k, (t, y) in enumerate(ev):
+            s = _solve_at(sysm, integ, t, y[:n], y[n:2 * n])
+            ck = s["contacts"][j]
+            d["t"][k], d["fn"][k], d["penetration"][k] = t, ck["fn"], ck["delta"]
+            if mech.main_joint in rows:
+                f = s["lam"][rows[mech.main_joint]]
+            elif mech.main_joint in names:
+                f = s["contacts"][names.index(mech.main_joint)]["force"]
+            else:
+                f = np.zeros(2)
+            d["main_bearing_force"][k] = float(np.hypot(f[0], f[1]))
+            for i, sl in enumerate(piston_sl):
+                d["piston_acceleration"][k, i] = mech.axes[i] @ s["qdd"][sl][:2]
+        out[cj.name] = d
+    return out
 
 
 def _impact_velocity(onsets, t, cj) -> float:

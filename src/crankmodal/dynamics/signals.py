@@ -86,6 +86,24 @@ def whirl_components(t, fx, fy, revolution_hz, order):
             abs(np.mean(z * np.exp(1j * order * ph))))
 
 
+def contact_durations(onsets, separations) -> np.ndarray:
+    """Duration of each contact of one clearance joint: from an onset to the first separation
+    after it, s (a contact still closed at the end is left out).
+
+    Parameters
+    ----------
+    onsets : list of (t, v)
+        Contact onsets (s) and approach velocities (m/s).
+    separations : list of float
+        Contact separations, s.
+    """
+    t_on = np.asarray(onsets, float).reshape(-1, 2)[:, 0]
+    sep = np.sort(np.asarray(separations, float))
+    k = np.searchsorted(sep, t_on, side="right")
+    ok = k < sep.size
+    return sep[k[ok]] - t_on[ok]
+
+
 def impact_statistics(onsets, separations=None, v_min=0.0, min_flight=0.0) -> dict:
     """Count and velocities of the impacts of one clearance joint.
 

@@ -58,12 +58,18 @@ class Integration:
     y: np.ndarray
     onsets: list = field(default_factory=list)       # per clearance joint: [(t, v_impact)]
     separations: list = field(default_factory=list)  # per clearance joint: [t]
+    peaks: list = field(default_factory=list)        # per clearance joint: [(t, state)] at the
+    #                                                  deepest penetration of each contact
     nfev: int = 0
     n_steps: int = 0
     wall_time: float = 0.0
 
 
 def _events(sysm, in_contact, memory):
+    """Event functions and their tags ``(joint, kind)``: contact onset (``on``) and separation
+    (``off``) as zero crossings of the penetration, and the deepest penetration of a contact
+    (``peak``: the penetration rate falling through zero) — the instant of the impact's peak
+    force, which output samples a few contact durations apart would miss."""
     n = sysm.n
     evs, tags = [], []
     for j, cj in enumerate(sysm.clearances):
@@ -78,6 +84,14 @@ def _events(sysm, in_contact, memory):
             g.terminal = memory
             evs.append(g)
             tags.append((j, kind))
+
+        def rate(t, y, cj=cj):
+            return cj.kinematics(sysm, y[:n], y[n:2 * n])["delta_dot"]
+
+        rate.direction = -1.0
+        rate.terminal = False
+        evs.append(rate)
+        tags.append((j, "peak"))
     return evs, tags
 
 
@@ -123,6 +137,7 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     in_contact = [cj.gap(sysm, q0) > 0.0 for cj in sysm.clearances]
     onsets = [[] for _ in sysm.clearances]
     separations = [[] for _ in sysm.clearances]
+    peaks = [[] for _ in sysm.clearances]
     ts, ys = [], []
     t = 0.0
     own_steps = t_out is None
@@ -173,6 +188,10 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
             for te_k, ye_k in zip(sol.t_events[k], sol.y_events[k]):
                 if memory and te_k <= t:
                     continue
+                if kind == "peak":  # also fires at the widest free flight: keep contacts only
+                    if sysm.clearances[j].gap(sysm, ye_k[:n]) > 0.0:
+                        peaks[j].append((float(te_k), np.array(ye_k, float)))
+                    continue
                 if kind == "on":
                     v = sysm.clearances[j].kinematics(sysm, ye_k[:n], ye_k[n:2 * n])["delta_dot"]
                     onsets[j].append((float(te_k), float(v)))
@@ -191,5 +210,5 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
             t = t_end
     tt = np.concatenate(ts) if ts else np.zeros(0)
     yy = np.concatenate(ys, axis=1) if ys else np.zeros((2 * n + N_AUX, 0))
-    return Integration(t=tt, y=yy, onsets=onsets, separations=separations, nfev=sysm.nfev,
-                       n_steps=n_steps, wall_time=time.perf_counter() - t0)
+    return Integration(t=tt, y=yy, onsets=onsets, separations=separations, peaks=peaks,
+                       nfev=sysm.nfev, n_steps=n_steps, wall_time=time.perf_counter() - t0)

@@ -30,6 +30,33 @@ def validate(raw: dict, scene) -> dict:
     return p
 
 
+def short_contact_warning(cj, duration: float, dt: float) -> str:
+    """The warning for contacts shorter than two output steps: the sampled histories miss them."""
+    from .contact import cylinder_stiffness
+
+    text = (f"dynamics: the contacts of joint {cj.name!r} last {duration:.2g} s (median), "
+            f"under two output steps ({dt:.2g} s): the sampled force histories and the "
+            f"main-bearing spectrum miss the impacts (the peaks in results.json are taken at "
+            f"each contact's deepest point); lower dynamics.output_step below {duration / 4:.2g} s")
+    K, n = cj.law_params.get("stiffness"), cj.law_params.get("exponent")
+    if K is not None and n == 1.5:  # compare with the steel cylinder-in-cylinder value
+        r = cj.journal_radius
+        k_steel = float(cylinder_stiffness(r, r + cj.clearance, 2.1e11, 0.3, 2.1e11, 0.3))
+        if K > 100.0 * k_steel:
+            text += (f", or check contact.stiffness = {K:.3g} N/m^1.5: {K / k_steel:.2g} times "
+                     f"a steel journal in a steel bore of these radii ({k_steel:.3g})")
+    return text
+
+
+def _warn(res: dict, text: str) -> None:
+    import warnings
+
+    from ..errors import ModelWarning
+
+    warnings.warn(text, ModelWarning, stacklevel=3)
+    res["warnings"].append(text)
+
+
 def _window(hist, p, rev_hz):
     """Sample mask of the spectrum window: a whole number of revolutions after the start-up."""
     t0 = p["spectrum_start"]
@@ -47,6 +74,7 @@ def run(params: dict, ctx) -> dict:
     from .build import build_mechanism, solver_settings
     from .signals import (
         amplitude_spectrum,
+        contact_durations,
         contact_loss_indicator,
         force_direction,
         impact_statistics,
@@ -70,15 +98,16 @@ def run(params: dict, ctx) -> dict:
            "end_time_s": t_end, "output_step_s": dt, "rhs_evals": hist.nfev,
            "integration_wall_time_s": hist.wall_time}
     f = hist.main_bearing_force
-    res["main_bearing_force_peak_n"] = float(np.max(np.hypot(f[:, 0], f[:, 1])))
+    # peaks: the samples and each contact's deepest point (an event: samples miss short impacts)
+    res["main_bearing_force_peak_n"] = hist.peak("main_bearing_force", np.hypot(f[:, 0], f[:, 1]))
     mm = hist.main_bearing_moment
     res["main_bearing_moment_peak_nm"] = float(np.max(np.hypot(mm[:, 0], mm[:, 1])))
     if n_rev >= 1:
         amps = order_amplitudes(hist.t[sel], f[sel], rev_hz, orders)
         res["main_bearing_orders"] = orders
         res["main_bearing_order_amplitude_n"] = amps.tolist()  # rows: order; columns: x, y
-    res["piston_acceleration_peak"] = np.max(np.abs(hist.piston_acceleration), axis=0).tolist() \
-        if hist.piston_acceleration.size else []
+    res["piston_acceleration_peak"] = hist.peak("piston_acceleration",
+                                                hist.piston_acceleration).tolist()
     res["angular_acceleration_peak"] = {name: float(np.max(np.abs(v[sel])))
                                         for name, v in hist.angular_acceleration.items()}
     res["drive_torque_peak_nm"] = float(np.max(np.abs(hist.drive_torque[sel])))
@@ -88,14 +117,20 @@ def run(params: dict, ctx) -> dict:
     res["energy_balance_error"] = hist.energy_error()
     res["constraint_drift_max"] = float(hist.constraint_drift.max())
     joints = {}
+    res["warnings"] = []
     for cj in mech.system.clearances:
         d = hist.contact[cj.name]
+        dur = contact_durations(hist.onsets[cj.name], hist.separations[cj.name])
         j = {"clearance_m": cj.clearance, "law": cj.law,
              "stiffness": float(cj.law_params["stiffness"]),
-             "peak_contact_force_n": float(d["fn"].max()),
-             "max_penetration_m": float(max(d["penetration"].max(), 0.0)),
-             "contact_fraction": float(np.mean(d["penetration"][sel] > 0.0))}
+             "peak_contact_force_n": hist.peak("fn", d["fn"], cj.name),
+             "max_penetration_m": hist.peak("penetration", np.maximum(d["penetration"], 0.0),
+                                            cj.name),
+             "contact_fraction": float(np.mean(d["penetration"][sel] > 0.0)),
+             "contact_duration_median_s": float(np.median(dur)) if dur.size else None}
         j.update(impact_statistics(hist.onsets[cj.name], v_min=cj.v_impact_min))
+        if dur.size and np.median(dur) < 2.0 * dt:
+            _warn(res, short_contact_warning(cj, float(np.median(dur)), dt))
         if ideal is not None:
             j["contact_loss"] = contact_loss_indicator(ideal.t[sel], ideal.joint_forces[cj.name][sel],
                                                        ideal.crank_angle[sel])
