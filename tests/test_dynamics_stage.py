@@ -143,3 +143,15 @@ def test_impact_peaks_do_not_depend_on_the_output_step(tmp_path):
     assert len(coarse_warn) == 1 and coarse["warnings"] == [str(coarse_warn[0].message)]
     assert "'big_end_1'" in coarse["warnings"][0] and "output_step" in coarse["warnings"][0]
 
+
+def test_a_ring_friction_no_integrator_can_follow_is_refused_by_name(tmp_path):
+    # F tanh(v / 0.01 m/s) on a 1.2 kg piston is a damper with time constant m v_f / F: at 1e6 N
+    # 1.2e-8 s (the run would crawl until its evaluation budget); the limit is 1.2e5 N (1e-7 s).
+    import copy
+
+    data = copy.deepcopy(SMALL)
+    data["dynamics"]["ring_friction_n"] = 1e6
+    with pytest.raises(SceneError, match=r"dynamics.ring_friction_n: 1e\+06 N.*1.2e-08 s.*"
+                                         r"must be <= 1.2e\+05 N"):
+        run(_scene(data), tmp_path, figures=False)
+    assert not (tmp_path / "results.json").exists()

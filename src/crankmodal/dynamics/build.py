@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import SceneError
 from . import contact
 from .loads import tabulated_gas_force
 from .mechanisms import Cylinder, crank_train, four_bar
@@ -37,6 +38,26 @@ def contact_arguments(p) -> tuple[dict, dict]:
     return kw, specs
 
 
+#: shortest admissible time constant m v_f / F of a piston's smoothed ring friction, s: below it
+#: the friction is a damper so stiff that the explicit integrator crawls through every step
+MIN_FRICTION_TIME = 1e-7
+
+
+def check_ring_friction(force: float, cylinders) -> None:
+    """Refuse a ring friction that would make each piston a near-rigid damper (SceneError)."""
+    from .loads import PistonLoads
+
+    if force <= 0.0:
+        return
+    v_f = PistonLoads.friction_velocity
+    m = min(c.piston_mass for c in cylinders)
+    if m * v_f / force < MIN_FRICTION_TIME:
+        raise SceneError(
+            f"dynamics.ring_friction_n: {force:.3g} N, smoothed over {v_f:g} m/s, damps the "
+            f"{m:.3g} kg piston with a time constant of {m * v_f / force:.2g} s, which no "
+            f"integrator step can follow; must be <= {m * v_f / MIN_FRICTION_TIME:.3g} N")
+
+
 def build_mechanism(p, mechanism_params=None):
     """The mechanism described by validated parameters ``p``.
 
@@ -53,6 +74,7 @@ def build_mechanism(p, mechanism_params=None):
         from .bridge import cylinders_from_mechanism
 
         src = cylinders_from_mechanism(mechanism_params, p["ring_friction_n"])
+        check_ring_friction(p["ring_friction_n"], src["cylinders"])
         speed = p["speed_rpm"] or src["speed_rpm"]
         common = _common(p, speed, specs, kw, src["direction"])
         com = src["crank_unbalance"] / ct["crank_mass"] if ct["crank_mass"] > 0 else 0.0
@@ -75,6 +97,7 @@ def build_mechanism(p, mechanism_params=None):
                      piston_mass=ct["piston_mass"], offset=ct["offset"], z=zi, gas_force=gas,
                      ring_friction=p["ring_friction_n"])
             for a, zi in zip(angles, z)]
+    check_ring_friction(p["ring_friction_n"], cyls)
     return crank_train(ct["crank_radius"], cyls, crank_mass=ct["crank_mass"],
                        crank_inertia=ct["crank_inertia"], crank_com=ct["crank_com"],
                        kind=p["mechanism"], **common)
