@@ -67,13 +67,11 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
 def key_outputs(hist: History, revolution_hz: float, t_start: float, orders=(1, 2, 3, 4)) -> dict:
     """The quantities a tolerance study compares: peaks and main-bearing order amplitudes."""
     sel = hist.t >= t_start
-    late = list(hist.peaks.values())  # each contact's deepest point (events)
-    fn = max([float(np.max(c["fn"][sel], initial=0.0)) for c in hist.contact.values()]
-             + [float(np.max(pk["fn"][pk["t"] >= t_start], initial=0.0)) for pk in late],
-             default=0.0)
-    acc = max([float(np.max(np.abs(hist.piston_acceleration[sel]), initial=0.0))]
-              + [float(np.max(np.abs(pk["piston_acceleration"][pk["t"] >= t_start]), initial=0.0))
-                 for pk in late])
+    # the samples after t_start and each contact's deepest point after it (events)
+    fn = max((hist.peak("fn", c["fn"][sel], name, since=t_start)
+              for name, c in hist.contact.items()), default=0.0)
+    acc = float(np.max(hist.peak("piston_acceleration", hist.piston_acceleration[sel],
+                                 since=t_start), initial=0.0))
     t = hist.t[sel]
     n_rev = int(np.floor((t[-1] - t[0]) * revolution_hz + 1e-9)) if t.size > 1 else 0
     if n_rev >= 1:

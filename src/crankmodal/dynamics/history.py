@@ -97,15 +97,19 @@ class History:
                 out[f"peaks_{name}_{k}"] = v
         return out
 
-    def peak(self, key: str, sampled, name: str | None = None):
+    def peak(self, key: str, sampled, name: str | None = None, since: float | None = None):
         """Largest magnitude of a sampled quantity and of its values at the contacts' deepest
-        points (``key`` of :attr:`peaks`; every joint's, or joint ``name``'s).
+        points (``key`` of :attr:`peaks`; every joint's, or joint ``name``'s; from time
+        ``since`` on, s, if given — the samples are the caller's to select).
 
         ``sampled`` of shape (K,) gives a float; of shape (K, P), one peak per column.
         """
         sampled = np.abs(np.asarray(sampled, float))
-        parts = [sampled] + [np.abs(pk[key]).reshape((len(pk["t"]),) + sampled.shape[1:])
-                             for j, pk in self.peaks.items() if name is None or j == name]
+        parts = [sampled]
+        for j, pk in self.peaks.items():
+            if name is None or j == name:
+                keep = slice(None) if since is None else pk["t"] >= since
+                parts.append(np.abs(pk[key]).reshape((len(pk["t"]),) + sampled.shape[1:])[keep])
         out = np.max(np.concatenate(parts), axis=0, initial=0.0)
         return float(out) if out.ndim == 0 else out
 
