@@ -83,7 +83,7 @@ def _run(scene_file: Path, overrides, out: Path | None, figures: bool) -> int:
     from .scene import load_scene
 
     scene = load_scene(scene_file, overrides)
-    out_dir = out if out is not None else Path("out") / scene.name
+    out_dir = out if out is not None else _default_out("run", scene.name)
     results = run(scene, out_dir, figures=figures, log=lambda s: print(s, file=sys.stderr))
     print(_summary(results))
     print(f"results: {out_dir / 'results.json'}")
@@ -95,15 +95,20 @@ SUMMARY_FILES = {"run": ("results.json", ""), "demo": ("results.json", ""),
                  "study": ("study.json", "_study")}
 
 
+def _default_out(command: str, name: str) -> Path:
+    """The output folder of ``command`` when no ``--out`` is given: ``out/<scene name><suffix>``."""
+    return Path("out") / (name + SUMMARY_FILES[command][1])
+
+
 def _remove_stale_summary(args) -> None:
     """After a failed ``run``/``demo``/``study``, delete the summary file (``results.json``,
     ``study.json``) that an earlier run left in the output folder, so that no old result looks
     like the answer to this run. Nothing else is deleted, and no folder is created."""
     if args.command not in SUMMARY_FILES:
         return
-    filename, suffix = SUMMARY_FILES[args.command]
+    filename = SUMMARY_FILES[args.command][0]
     out_dir = args.out
-    if out_dir is None:  # the default folder out/<scene name><suffix>, as _run/study name it
+    if out_dir is None:
         from .resources import load_toml, scene_path
 
         demo = args.command == "demo"
@@ -114,7 +119,7 @@ def _remove_stale_summary(args) -> None:
             # A missing or unparsable file: its stem, the name of a scene without a `name`
             # key, is the best guess.
             name = None
-        out_dir = Path("out") / ((name if isinstance(name, str) else stem) + suffix)
+        out_dir = _default_out(args.command, name if isinstance(name, str) else stem)
     try:
         (Path(out_dir) / filename).unlink(missing_ok=True)
     except OSError:  # e.g. DIR is a file: there is no stale summary to remove
@@ -165,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
             from .scene import load_scene
 
             scene = load_scene(args.scene, args.overrides)
-            out_dir = args.out if args.out is not None else Path("out") / f"{scene.name}_study"
+            out_dir = args.out if args.out is not None else _default_out("study", scene.name)
             res = simplification_study(scene, out_dir, figures=not args.no_figures,
                                        log=lambda m: print(m, file=sys.stderr))
             print(res["summary"])

@@ -39,3 +39,13 @@ class ModelWarning(UserWarning):
     """A model that will compute, but whose answer deserves suspicion (locking, units, impacts
     shorter than the output step). The CLI prints it as one ``crankmodal: warning:`` line and the
     stage keeps it in its ``warnings`` in results.json."""
+
+
+def warn(text: str, into: list | None = None) -> None:
+    """Issue a :class:`ModelWarning` and, with ``into``, keep its text there (a stage's
+    ``warnings`` in results.json)."""
+    import warnings
+
+    warnings.warn(text, ModelWarning, stacklevel=3)
+    if into is not None:
+        into.append(text)

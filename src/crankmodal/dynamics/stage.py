@@ -48,15 +48,6 @@ def short_contact_warning(cj, duration: float, dt: float) -> str:
     return text
 
 
-def _warn(res: dict, text: str) -> None:
-    import warnings
-
-    from ..errors import ModelWarning
-
-    warnings.warn(text, ModelWarning, stacklevel=3)
-    res["warnings"].append(text)
-
-
 def _window(hist, p, rev_hz):
     """Sample mask of the spectrum window: a whole number of revolutions after the start-up."""
     t0 = p["spectrum_start"]
@@ -70,6 +61,7 @@ def _window(hist, p, rev_hz):
 
 
 def run(params: dict, ctx) -> dict:
+    from ..errors import warn
     from .analysis import key_outputs, simulate, tolerance_study
     from .build import build_mechanism, solver_settings
     from .signals import (
@@ -130,7 +122,7 @@ def run(params: dict, ctx) -> dict:
              "contact_duration_median_s": float(np.median(dur)) if dur.size else None}
         j.update(impact_statistics(hist.onsets[cj.name], v_min=cj.v_impact_min))
         if dur.size and np.median(dur) < 2.0 * dt:
-            _warn(res, short_contact_warning(cj, float(np.median(dur)), dt))
+            warn(short_contact_warning(cj, float(np.median(dur)), dt), into=res["warnings"])
         if ideal is not None:
             j["contact_loss"] = contact_loss_indicator(ideal.t[sel], ideal.joint_forces[cj.name][sel],
                                                        ideal.crank_angle[sel])

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import GeometryError, ModelWarning
+from ..errors import GeometryError, warn
 from .memory import release_free_heap
 
 
@@ -196,7 +196,6 @@ def assemble(part, material, timings: dict | None = None) -> FEModel:
     FEModel
     """
     import time
-    import warnings
 
     from skfem import CellBasis
 
@@ -261,7 +260,7 @@ def assemble(part, material, timings: dict | None = None) -> FEModel:
     used[cells.ravel()] = True
     notes = model_warnings(points[used], order, material.nu)
     for text in notes:
-        warnings.warn(text, ModelWarning, stacklevel=2)
+        warn(text)
     release_free_heap()  # the element arrays just freed would otherwise stay resident
     return FEModel(points=points, cells=cells, order=order, K=K, M=M, material=material,
                    used=used, timings=timings, warnings=notes)

@@ -72,16 +72,13 @@ def run(p: dict, ctx) -> dict:
         "warnings": list(model.warnings),
     })
     if p["band"] is not None and not modes.band_complete:
-        import warnings
-
-        from ..errors import ModelWarning
+        from ..errors import warn
 
         f_top = modes.frequencies_hz[-1]
         text = (f"modal.band: the {len(modes.frequencies_hz)} modes computed reach {f_top:.1f} Hz, "
                 f"below the band's {p['band'][1]:g} Hz: modes between them were not computed; "
                 f"raise modal.n_modes")
-        warnings.warn(text, ModelWarning, stacklevel=2)
-        res["warnings"].append(text)
+        warn(text, into=res["warnings"])
     if part.cad_mass is not None:
         cad = part.cad_mass.mass(mat.rho)
         res["mass_vs_cad"] = modes.total_mass / cad - 1.0
