@@ -5,7 +5,7 @@ import pytest
 from fem_beam_theory import rectangle_shear_coefficient, timoshenko_frequencies
 from fem_parts import bar, tube
 
-from crankmodal.errors import NumericalError
+from crankmodal.errors import ModelWarning, NumericalError
 from crankmodal.fem import assembly, modal, supports
 from crankmodal.fem.materials import material
 
@@ -99,7 +99,7 @@ def test_same_input_gives_identical_modes(bar_model, free_modes):
 def test_sub_millimetre_part_scales_frequencies_inversely_with_size():
     """A 0.5 mm bar has exactly 2000× the frequencies of a 1 m bar: the solver is scale-free."""
     big = modal.solve_modes(assembly.assemble(bar(1.0, 0.05, 0.04, (16, 2, 2)), STEEL), 4)
-    with pytest.warns(assembly.ModelWarning, match="metres"):
+    with pytest.warns(ModelWarning, match="metres"):
         small_model = assembly.assemble(bar(5e-4, 2.5e-5, 2e-5, (16, 2, 2)), STEEL)
     small = modal.solve_modes(small_model, 4)
     np.testing.assert_allclose(small.frequencies_hz, 2e3 * big.frequencies_hz, rtol=1e-7)
@@ -107,13 +107,13 @@ def test_sub_millimetre_part_scales_frequencies_inversely_with_size():
 
 
 def test_part_given_in_millimetres_warns_about_units():
-    with pytest.warns(assembly.ModelWarning, match="mm input"):
+    with pytest.warns(ModelWarning, match="mm input"):
         assembly.assemble(bar(1000.0, 50.0, 40.0, (8, 1, 1), order=1), STEEL)
 
 
 def test_p1_with_nearly_incompressible_material_warns_about_locking():
     rubberish = material("steel").__class__(name="x", E=1e7, nu=0.49, rho=1000.0)
-    with pytest.warns(assembly.ModelWarning, match="locking"):
+    with pytest.warns(ModelWarning, match="locking"):
         assembly.assemble(bar(1.0, 0.1, 0.1, (4, 1, 1), order=1), rubberish)
 
 
@@ -126,10 +126,10 @@ def test_p2_near_incompressible_material_warns_and_fails_loudly_with_advice():
         return assembly.assemble(bar(1.0, 0.1, 0.1, (10, 2, 2), order=2), mat)
 
     f_ref = modal.solve_modes(model(0.4999), 2).frequencies_hz
-    with pytest.warns(assembly.ModelWarning, match=r"nu = 0.49999: the bulk modulus is 5.0e\+04"):
+    with pytest.warns(ModelWarning, match=r"nu = 0.49999: the bulk modulus is 5.0e\+04"):
         near = model(0.49999)
     np.testing.assert_allclose(modal.solve_modes(near, 2).frequencies_hz, f_ref, rtol=1e-3)
-    with pytest.warns(assembly.ModelWarning):
+    with pytest.warns(ModelWarning):
         bad = model(0.4999999)
     with pytest.raises(NumericalError, match=r"ill-conditioned .* nu = 0.4999999 makes the bulk "
                                              r"modulus 5.0e\+06 .* use nu <= 0.4999"):
