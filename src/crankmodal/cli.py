@@ -25,11 +25,14 @@ def _parser() -> argparse.ArgumentParser:
     p = _Parser(prog="crankmodal", description=__doc__.splitlines()[0])
     p.add_argument("--version", action="version", version=f"crankmodal {__version__}")
     p.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
     # --debug is also accepted after the command; SUPPRESS keeps a subcommand that was not given
     # it from overwriting the top-level value.
     debug = argparse.ArgumentParser(add_help=False)
     debug.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                        help="show tracebacks of errors")
+    debug.add_argument("--quiet", action="store_true", default=argparse.SUPPRESS,
+                       help="no progress bars")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     def scene_args(sp, scene_required=True):
@@ -151,6 +154,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = _parser().parse_args(argv)
         debug = args.debug
+        if args.quiet:
+            from .progress import set_quiet
+
+            set_quiet()
         if args.command == "run":
             return _run(args.scene, args.overrides, args.out, not args.no_figures)
         if args.command == "demo":
