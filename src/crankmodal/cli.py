@@ -1,7 +1,8 @@
 """Command line: ``crankmodal run | check | demo | study | machines``.
 
 User errors (:class:`~crankmodal.errors.CrankmodalError`) print one line on stderr and exit with
-status 2 (3 for a failed numerical check), without a traceback unless ``--debug`` is given.
+status 2 (3 for a failed numerical check), without a traceback unless ``--debug`` is given; so do
+output files that cannot be written (:class:`~crankmodal.errors.OutputError`).
 """
 
 from __future__ import annotations
@@ -188,11 +189,15 @@ def main(argv: list[str] | None = None) -> int:
 
             print("\n".join(list_machines()))
             return 0
-    except CrankmodalError as exc:
+    except (CrankmodalError, OSError) as exc:
         if args is not None:
             _remove_stale_summary(args)
         if debug:
             raise
+        if isinstance(exc, OSError):  # an I/O failure no stage turned into an OutputError
+            from .results import output_error
+
+            exc = output_error(exc)
         print(f"crankmodal: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt:

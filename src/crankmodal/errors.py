@@ -20,6 +20,11 @@ class InputFileError(CrankmodalError):
     """A file named in a scene is missing or unreadable."""
 
 
+class OutputError(CrankmodalError):
+    """An output file or folder cannot be written (the folder is a file, read-only, the disk is
+    full); the message names the path and the system's reason."""
+
+
 class GeometryError(CrankmodalError):
     """A parameter set describes an impossible part, or the geometry kernel failed on it."""
 

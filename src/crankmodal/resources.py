@@ -7,6 +7,7 @@ folders of the user's own machine files, searched first.
 
 from __future__ import annotations
 
+import codecs
 import os
 import tomllib
 from pathlib import Path
@@ -50,17 +51,50 @@ def machine_path(name: str, key: str = "machine") -> Path:
 
 
 def load_toml(path: Path) -> dict:
-    """Read a TOML file, turning I/O and syntax errors into one-line user errors."""
+    """Read a TOML file, turning I/O, encoding and syntax errors into one-line user errors."""
     path = Path(path)
     if not path.is_file():
         raise InputFileError(f"file not found: {path}")
     try:
         with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: invalid TOML: {exc}") from None
+            raw = fh.read()
     except OSError as exc:
         raise InputFileError(f"{path}: cannot read: {exc.strerror}") from None
+    try:
+        return tomllib.loads(decode_utf8(raw, path))
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: invalid TOML: {exc}") from None
+
+
+#: Byte-order marks of the encodings a TOML file must not be in, by name.
+_BOMS = ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
+         (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16"))
+
+
+def decode_utf8(raw: bytes, path) -> str:
+    """The text of a TOML file, which must be UTF-8 without a byte-order mark (TOML 1.0).
+
+    Raises
+    ------
+    SceneError
+        Naming the file, the encoding it seems to be in (UTF-16/32 by their byte-order mark) or
+        the first byte that is not UTF-8 (line and column), and what to do.
+    """
+    for bom, name in _BOMS:  # UTF-32-LE's mark starts with UTF-16-LE's: longest first
+        if raw.startswith(bom):
+            raise SceneError(f"{path}: {name} text (it starts with a {name} byte-order mark); "
+                             "TOML files must be UTF-8: save it as UTF-8")
+    if raw.startswith(codecs.BOM_UTF8):
+        raise SceneError(f"{path}: starts with a UTF-8 byte-order mark, which TOML does not "
+                         "allow: save it as UTF-8 without BOM")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise SceneError(f"{path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at line {line}, "
+                         f"column {column}: {exc.reason}); TOML files must be UTF-8: "
+                         "save it as UTF-8") from None
 
 
 def load_machine(name: str, key: str = "machine") -> dict:

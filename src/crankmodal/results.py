@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -10,7 +11,7 @@ from dataclasses import asdict, is_dataclass
 from pathlib import Path
 from typing import Any
 
-from .errors import NumericalError
+from .errors import NumericalError, OutputError
 
 
 def to_jsonable(obj: Any, path: str = "") -> Any:
@@ -43,28 +44,92 @@ def to_jsonable(obj: Any, path: str = "") -> Any:
     raise TypeError(f"result {path}: cannot write {type(obj).__name__} to JSON")
 
 
-def write_atomic(path: str | Path, data: bytes | str) -> Path:
-    """Write ``data`` to ``path`` atomically: a temporary file in the same folder, then rename.
+def output_error(exc: OSError, path: str | Path | None = None) -> OutputError:
+    """The one-line :class:`~crankmodal.errors.OutputError` for an ``OSError`` met writing
+    ``path``: the path and the system's reason. Without ``path``, the file the system names."""
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    if path is None:
+        return OutputError(f"{exc.filename or 'a file'}: {reason}")
+    return OutputError(f"cannot write {path}: {reason}")
 
-    A reader sees either the old file, or the complete new one, never a partial write.
+
+def make_out_dir(path: str | Path) -> Path:
+    """Create the output folder ``path`` (and its parents) if needed.
+
+    Raises
+    ------
+    OutputError
+        If ``path`` is a file, lies under a file, or cannot be created (read-only, full disk);
+        the message names the folder.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    mode = "wb" if isinstance(data, bytes) else "w"
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    if path.exists() and not path.is_dir():
+        raise OutputError(f"output folder {path} is a file, not a folder")
     try:
+        path.mkdir(parents=True, exist_ok=True)
+    except NotADirectoryError:
+        raise OutputError(f"cannot create output folder {path}: a parent of it is a file") from None
+    except OSError as exc:
+        raise OutputError(f"cannot create output folder {path}: {exc.strerror or exc}") from None
+    return path
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path):
+    """Write a file atomically through any writer that takes a file name.
+
+    Yields a temporary path in the folder of ``path`` (created if missing), with the same suffix
+    (``.modes.vtu.<random>.vtu``: writers that pick their format from the suffix, such as
+    ``savefig``, ``meshio.write`` or PIL, and ``numpy.savez``, which appends ``.npz`` to any other
+    name, see the real one). When the block ends normally the file is flushed to disk and renamed
+    to ``path``, so a reader (or a run killed mid-write) sees the old file or the complete new
+    one, never a truncated one. When the block raises, the temporary file is removed; an
+    ``OSError`` (read-only folder, full disk) becomes an :class:`~crankmodal.errors.OutputError`
+    naming ``path``.
+    """
+    path = Path(path)
+    make_out_dir(path.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+        os.close(fd)
+    except OSError as exc:
+        raise output_error(exc, path) from None
+    try:
+        yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a result is an ordinary file
-        with os.fdopen(fd, mode) as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)  # the data reaches the disk before the rename makes it the file
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         try:
             os.unlink(tmp)
         except FileNotFoundError:
             pass
+        if isinstance(exc, OSError):
+            raise output_error(exc, path) from None
         raise
+
+
+def write_atomic(path: str | Path, data: bytes | str) -> Path:
+    """Write ``data`` to ``path`` atomically (see :func:`atomic_path`).
+
+    A reader sees either the old file, or the complete new one, never a partial write.
+    """
+    path = Path(path)
+    with atomic_path(path) as tmp, open(tmp, "wb" if isinstance(data, bytes) else "w") as fh:
+        fh.write(data)
+    return path
+
+
+def savefig_atomic(fig, path: str | Path, **kwargs) -> Path:
+    """``fig.savefig(path, **kwargs)`` through :func:`atomic_path` (the format from the suffix
+    of ``path``)."""
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, **kwargs)
     return path
 
 

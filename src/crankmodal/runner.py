@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import __version__
-from .errors import SceneError
-from .results import write_json_atomic
+from .errors import OutputError, SceneError
+from .results import make_out_dir, output_error, write_json_atomic
 from .scene import Scene
 
 #: section -> stage module, in data-flow order (a stage runs after everything above it).
@@ -99,7 +99,8 @@ def run(scene: Scene, out_dir: str | Path, figures: bool = True, log=None) -> di
         The scene to run.
     out_dir : str or Path
         Output folder (created). A stale ``results.json`` there is removed once the scene has
-        validated, so a failed run never leaves an old result looking new.
+        validated, so a failed run never leaves an old result looking new. Every file is
+        written atomically (:func:`crankmodal.results.atomic_path`).
     figures : bool
         Write PNG plots.
     log : callable, optional
@@ -109,18 +110,31 @@ def run(scene: Scene, out_dir: str | Path, figures: bool = True, log=None) -> di
     -------
     dict
         The results as written.
+
+    Raises
+    ------
+    OutputError
+        If the folder or a file in it cannot be written (a file in the way, read-only, disk
+        full); no results.json is left.
     """
     params = check(scene)
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "results.json").unlink(missing_ok=True)
+    out_dir = make_out_dir(out_dir)
+    try:
+        (out_dir / "results.json").unlink(missing_ok=True)
+    except OSError as exc:  # a read-only folder: say so before any stage computes
+        raise output_error(exc, out_dir / "results.json") from None
     results: dict = {"crankmodal_version": __version__, "scene": scene.name}
     ctx = StageContext(scene=scene, out_dir=out_dir, params=params, results=results, figures=figures)
     for section, p in params.items():
         if log:
             log(f"[{section}] running")
         t0 = time.perf_counter()
-        res = stage_module(section).run(p, ctx) or {}
+        try:
+            res = stage_module(section).run(p, ctx) or {}
+        except OSError as exc:
+            # A file that does not go through results.atomic_path (a plugin's writer, a reader):
+            # one line naming the file and the system's reason, as for every I/O error.
+            raise OutputError(f"[{section}]: {output_error(exc)}") from None
         res["wall_time_s"] = time.perf_counter() - t0
         results[section] = res
         if log:

@@ -11,9 +11,13 @@ from ..plotting import pyplot as _plt
 
 def _save(plt, fig, path: Path) -> Path:
     """Lay out, write (PNG, 110 dpi) and close a figure."""
+    from ..results import savefig_atomic
+
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    try:
+        savefig_atomic(fig, path, dpi=110)
+    finally:
+        plt.close(fig)
     return path
 
 

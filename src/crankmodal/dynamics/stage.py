@@ -62,6 +62,7 @@ def _window(hist, p, rev_hz):
 
 def run(params: dict, ctx) -> dict:
     from ..errors import warn
+    from ..results import atomic_path
     from .analysis import key_outputs, simulate, tolerance_study
     from .build import build_mechanism, solver_settings
     from .signals import (
@@ -153,7 +154,8 @@ def run(params: dict, ctx) -> dict:
         arrays["spectrum_order"] = spec.order
         arrays["spectrum_main_bearing_amplitude"] = spec.amplitude
     out = ctx.out_dir
-    np.savez_compressed(out / "dynamics.npz", **arrays)
+    with atomic_path(out / "dynamics.npz") as tmp:
+        np.savez_compressed(tmp, **arrays)
     res["arrays"] = "dynamics.npz"
     if ctx.figures:
         res["figures"] = _figures(hist, ideal, mech, sel, study, out, spec)

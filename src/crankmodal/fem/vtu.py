@@ -43,8 +43,11 @@ def write_point_data(path: str | Path, mesh, point_data: dict) -> Path:
     """Write the volume mesh (its tetra/tetra10 block) with the given point arrays."""
     import meshio
 
+    from ..results import atomic_path
+
     block = next(c for c in mesh.cells if c.type in ("tetra", "tetra10"))
     path = Path(path)
-    meshio.write(path, meshio.Mesh(np.asarray(mesh.points, float), [(block.type, block.data)],
-                                   point_data=point_data), binary=True)
+    with atomic_path(path) as tmp:  # a killed run leaves no truncated .vtu
+        meshio.write(tmp, meshio.Mesh(np.asarray(mesh.points, float), [(block.type, block.data)],
+                                      point_data=point_data), binary=True)
     return path

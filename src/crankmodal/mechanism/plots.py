@@ -42,9 +42,13 @@ def _finish(plt, fig, axes, path, grid="major"):
     for ax in axes:
         ax.grid(True, which=grid, alpha=0.3)
         ax.legend(fontsize=8)
+    from ..results import savefig_atomic
+
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        savefig_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
 
 
 def plot_gas_force(res, path):

@@ -208,6 +208,7 @@ def run(params: dict, ctx) -> dict:
     """Analyse one working cycle; write curves (npz) and figures; return the key numbers."""
     import numpy as np
 
+    from ..results import atomic_path
     from .analysis import analyse
     from .machine import machine_from_params
 
@@ -216,7 +217,8 @@ def run(params: dict, ctx) -> dict:
     res = analyse(machine, params["n_points"], params["max_order"], params["harmonics"])
     ctx.products[SECTION] = res
     out = ctx.out_dir
-    np.savez_compressed(out / "mechanism_curves.npz", **res.curves())
+    with atomic_path(out / "mechanism_curves.npz") as tmp:
+        np.savez_compressed(tmp, **res.curves())
     files = ["mechanism_curves.npz"]
     if ctx.figures:
         from .plots import write_all

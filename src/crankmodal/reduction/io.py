@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputFileError
+from ..results import atomic_path
 from .flexbody import FlexibleBody
 
 FORMAT = "crankmodal-flexbody"
@@ -68,9 +69,10 @@ def save_flexbody(path, body: FlexibleBody) -> Path:
     if body.stress_modes is not None:
         data["stress_modes"] = body.stress_modes
         data["stress_points"] = body.stress_points
-    tmp = path.with_name(path.name + ".tmp.npz")
-    np.savez(tmp, **data)
-    tmp.replace(path)
+    # a unique temporary name (concurrent writers do not collide); through an open file, so
+    # savez appends no ".npz" to a name that lacks it
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        np.savez(fh, **data)
     return path
 
 

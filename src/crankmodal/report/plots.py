@@ -14,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..results import atomic_path, savefig_atomic
+
 _MARKERS = {"full": "o", "dechamfered": "s", "simplified": "^", "imported": "D"}
 _COLOURS = {1: "tab:blue", 2: "tab:red"}
 
@@ -27,7 +29,7 @@ def _figure(figsize=(7.0, 4.8)):
 
 
 def _write_csv(path: Path, header, rows) -> Path:
-    with open(path, "w", newline="") as fh:
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(header)
         w.writerows(rows)
@@ -85,8 +87,10 @@ def plot_error_vs_time(study, path) -> Path:
     ax.set_title("Error against run time (labels: mesh size, mm)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        savefig_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
     _write_csv(path.with_suffix(".csv"),
                ["label", "fidelity", "order", "mesh_size_m", "n_elements", "wall_time_s", "error",
                 "pareto", "recommended"],
@@ -138,8 +142,10 @@ def plot_convergence(runs, path, reference_hz=None, n_modes: int | None = None) 
                       ls="-" if order == 2 else ":", label=f"{fid} P{order}")
                for fid, order in groups]  # black: colour stands for the mode
     ax.legend(handles=handles, fontsize=8, title="colour: mode", title_fontsize=8)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        savefig_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
     _write_csv(path.with_suffix(".csv"), ["fidelity", "order", "mesh_size_m", "n_dofs"]
                + [f"f{k + 1}_hz" for k in range(n)], rows)
     return path
@@ -165,8 +171,10 @@ def plot_mac(mac, path, row_labels=None, col_labels=None, title="MAC",
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=10)
     fig.colorbar(im, ax=ax, shrink=0.8)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        savefig_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
     _write_csv(path.with_suffix(".csv"), [""] + list(cl),
                [[r] + [f"{v:.6f}" for v in row] for r, row in zip(rl, mac)])
     return path
@@ -197,8 +205,10 @@ def plot_participation(frequencies_hz, effective_mass, total_mass, path) -> Path
     ax.set_title("Mode participation: effective mass per mode and cumulative")
     ax.grid(True, axis="y", alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        savefig_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
     _write_csv(path.with_suffix(".csv"), ["mode", "frequency_hz", "x_fraction", "y_fraction",
                                           "z_fraction"],
                [[k + 1, f"{v:.6g}"] + [f"{q:.6g}" for q in frac[k]] for k, v in enumerate(f)])

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..results import atomic_path, make_out_dir
+
 #: Largest drawn displacement as a fraction of the part's bounding-box diagonal.
 DEFORMATION_FRACTION = 0.08
 
@@ -182,7 +184,8 @@ def render_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: d
         pl.add_text(f"deformation scaled to {100 * fraction:.0f} % of the part's size",
                     position="lower_left", font_size=9, color="#555555")
         _place_camera(pl, camera)
-        pl.screenshot(str(path))
+        with atomic_path(path) as tmp:
+            pl.screenshot(str(tmp))
     finally:
         pl.close()
     return Path(path)
@@ -209,7 +212,8 @@ def animate_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: 
             frames.append(Image.fromarray(np.asarray(img)).convert("P", palette=Image.ADAPTIVE))
     finally:
         pl.close()
-    frames[0].save(path, save_all=True, append_images=frames[1:], duration=80, loop=0)
+    with atomic_path(path) as tmp:
+        frames[0].save(tmp, save_all=True, append_images=frames[1:], duration=80, loop=0)
     return Path(path)
 
 
@@ -243,7 +247,8 @@ def render_scalar(surface: Surface, values: np.ndarray, path, title: str, camera
                                      "width": 0.06, "fmt": "%.3g"})
         pl.add_text(title, position="upper_edge", font_size=14, color="black")
         _place_camera(pl, camera)
-        pl.screenshot(str(path))
+        with atomic_path(path) as tmp:
+            pl.screenshot(str(tmp))
     finally:
         pl.close()
     return Path(path)
@@ -262,7 +267,8 @@ def contact_sheet(paths, path, columns: int = 3, thumb_width: int = 512) -> Path
     sheet = Image.new("RGB", (columns * w, rows * h), "white")
     for k, im in enumerate(imgs):
         sheet.paste(im.resize((w, h), Image.LANCZOS), ((k % columns) * w, (k // columns) * h))
-    sheet.save(path)
+    with atomic_path(path) as tmp:
+        sheet.save(tmp)
     return Path(path)
 
 
@@ -292,8 +298,7 @@ def render_modes(points, cells, frequencies_hz, shapes, out_dir, labels=None, pr
         ``modes`` (PNG paths), ``gifs`` (paths, possibly empty), ``sheet`` (path or None),
         ``camera``, ``surface`` (the :class:`Surface`, for further renders of the part).
     """
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = make_out_dir(out_dir)
     surf = boundary_surface(points, cells)
     cam = part_camera(surf.points, axis)
     shapes = np.asarray(shapes)

@@ -351,17 +351,15 @@ def write_study(study: SimplificationStudy, out_dir, measured_hz=None, title="",
         Paths written.
     """
     import csv
-    from pathlib import Path
 
-    from ..results import write_atomic
+    from ..results import atomic_path, make_out_dir, write_atomic
     from . import plots
 
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = make_out_dir(out_dir)
     paths = {}
     n = len(study.reference_hz)
     csv_path = out_dir / "study.csv"
-    with open(csv_path, "w", newline="") as fh:
+    with atomic_path(csv_path) as tmp, open(tmp, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["fidelity", "order", "mesh_size_m", "n_elements", "n_nodes", "n_dofs",
                     "mesh_time_s", "solve_time_s", "wall_time_s", "error", "pareto",

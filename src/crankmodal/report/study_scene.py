@@ -120,14 +120,11 @@ def simplification_study(scene, out_dir, log=None, figures: bool = True) -> dict
     dict
         The study (``to_dict()``) with a one-line ``summary``; also written to ``study.json``.
     """
-    from pathlib import Path
-
-    from ..results import write_json_atomic
+    from ..results import make_out_dir, write_json_atomic
     from ..runner import check
 
     params = check(scene)
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = make_out_dir(out_dir)
     st, paths = run_simplification(params, out_dir, log=log, figures=figures)
     out = {**st.to_dict(), "files": {k: str(v) for k, v in paths.items()},
            "summary": f"{len(st.runs)} models; recommended: {st.recommendation_text()}"}

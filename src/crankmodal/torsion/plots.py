@@ -11,9 +11,13 @@ from ..plotting import pyplot as _pyplot
 
 def _save(plt, fig, path) -> Path:
     """Write the PNG and free the figure."""
+    from ..results import savefig_atomic
+
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        savefig_atomic(fig, path, dpi=120)
+    finally:
+        plt.close(fig)
     return Path(path)
 
 

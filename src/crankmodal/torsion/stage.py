@@ -181,6 +181,7 @@ def validate(raw: dict, scene) -> dict:
 
 def run(p: dict, ctx) -> dict:
     """Solve the chain three ways, check the critical speeds, write tables and figures."""
+    from ..results import write_atomic
     from .chain import exact_modes
     from .critical_speeds import critical_speeds
     from .holzer import holzer
@@ -203,7 +204,7 @@ def run(p: dict, ctx) -> dict:
 
     out = ctx.out_dir
     text = "\n\n".join(hz.table_text(m) for m in range(len(hz.frequencies_hz)))
-    (out / "torsion_holzer_tables.txt").write_text(text + "\n")
+    write_atomic(out / "torsion_holzer_tables.txt", text + "\n")
     figures = []
     if ctx.figures:
         from .plots import plot_campbell, plot_holzer_residual, plot_mode_shapes
