@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..part import Part
 from .checks import check_conrod, check_crankshaft, check_fidelity
 from .massprops import cad_mass_properties, compare, mesh_mass_properties
-from .mesh import MeshSettings, detail_faces, generate, quality, set_sizes, to_meshio
+from .mesh import MeshSettings, check_size, detail_faces, generate, quality, set_sizes, to_meshio
 from .params import ConrodParams, CrankshaftParams
 from .regions import regions_from_mesh, tag_regions
 from .session import gmsh_session, quiet_stdout
@@ -31,6 +31,9 @@ def mesh_tagged(gmsh, volumes: list, specs: list, settings: MeshSettings, refine
         The meshio mesh, the named :class:`~crankmodal.part.Region` objects and the mesh
         statistics of :func:`~crankmodal.geometry.mesh.quality`.
     """
+    volume = sum(gmsh.model.occ.getMass(3, v) for v in volumes)
+    area = sum(gmsh.model.occ.getMass(2, s) for _, s in gmsh.model.getEntities(2))
+    check_size(volume, area, settings)  # before gmsh meshes: an absurd size is refused at once
     tagged = tag_regions(gmsh, specs)
     gmsh.model.addPhysicalGroup(3, volumes, name="solid")
     set_sizes(gmsh, settings, list(refined))

@@ -34,6 +34,32 @@ SCHEMA = {
 }
 
 
+#: Sections that factorise the part's stiffness matrix.
+FE_SECTIONS = ("modal", "static", "reduction")
+
+
+def mesh_settings(p: dict):
+    """The :class:`~crankmodal.geometry.mesh.MeshSettings` of validated parameters ``p``: the
+    element limit is :data:`~crankmodal.geometry.mesh.MAX_ELEMENTS`, or fewer when an FE stage
+    follows and the memory available could not hold its factorisation."""
+    from .mesh import MAX_ELEMENTS, MeshSettings, fe_element_limit
+
+    limit, reason = MAX_ELEMENTS, "crankmodal's limit on the mesh size"
+    if p.get("fe_follows"):
+        from ..fem.memory import available_bytes
+
+        avail = available_bytes()
+        fe = fe_element_limit(p["element_order"], avail)
+        # 1.5x: the count estimate is within -35 % / +19 %, and the FE stage's own memory
+        # check, on the real DOF count, decides the close cases
+        if fe is not None and 1.5 * fe < limit:
+            limit = 1.5 * fe
+            reason = (f"1.5x the P{p['element_order']} elements whose FE factorisation, "
+                      f"0.42 GB x (DOF / 85k)^1.5, fits in the {avail / 1e9:.3g} GB available")
+    return MeshSettings(size=p["mesh_size"], order=p["element_order"], refine=p["refine"],
+                        optimize=p["optimize"], max_elements=limit, limit_reason=reason)
+
+
 def validate(raw: dict, scene) -> dict:
     """Check the section; resolve the file or the machine's part table; check part parameters."""
     from .checks import check_conrod, check_crankshaft
@@ -41,6 +67,8 @@ def validate(raw: dict, scene) -> dict:
     from .params import params_from_dict
 
     p = validate_table(SECTION, raw, SCHEMA)
+    # the FE stages that will factorise this mesh bound its size by the memory (make_part)
+    p["fe_follows"] = any(s in scene.sections for s in FE_SECTIONS)
     if (p["file"] is None) == (p["machine"] is None and p["params"] is None):
         raise SceneError("geometry: give either file = \"...\" or machine = \"...\" (with part, fidelity)")
     if p["file"] is not None:
@@ -82,10 +110,8 @@ def validate(raw: dict, scene) -> dict:
 def make_part(p: dict):
     """Build or import the part of validated parameters ``p``, through the on-disk cache."""
     from .cache import file_digest, load_part, part_key, store_part
-    from .mesh import MeshSettings
 
-    settings = MeshSettings(size=p["mesh_size"], order=p["element_order"], refine=p["refine"],
-                            optimize=p["optimize"])
+    settings = mesh_settings(p)
     if p["file"] is not None:
         desc = {"file": file_digest(p["file"]), "suffix": p["file"].rsplit(".", 1)[-1].lower(),
                 "regions": p["regions"], "mesh": settings.to_dict()}
@@ -124,9 +150,15 @@ def run(p: dict, ctx) -> dict:
     if p["write_mesh"]:
         import meshio
 
+        from ..errors import OutputError
+        from ..results import atomic_path
+
         target = ctx.out_dir / p["write_mesh"]
         try:
-            meshio.write(target, part.mesh)
+            with atomic_path(target) as tmp:  # the suffix kept: meshio picks the format by it
+                meshio.write(tmp, part.mesh)
+        except OutputError:
+            raise
         except Exception as exc:  # noqa: BLE001 - meshio: unknown extension or writer failure
             raise SceneError(f"geometry.write_mesh: cannot write {p['write_mesh']!r} ({exc})") from None
         out["mesh_file"] = str(target)
