@@ -134,6 +134,15 @@ def savefig_atomic(fig, path: str | Path, **kwargs) -> Path:
 
 
 def _umask() -> int:
+    """The process's umask, read without changing it where Linux says it (Linux >= 4.7): setting
+    and restoring it would let a file another thread creates meanwhile get mode 0666."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
     mask = os.umask(0)
     os.umask(mask)
     return mask
