@@ -343,3 +343,42 @@ def test_element_estimate_against_gmsh(monkeypatch, tmp_path):
     assert seen["volume"] == pytest.approx(part.cad_mass.volume, rel=1e-9)
     ratio = estimate_elements(seen["volume"], seen["area"], 0.006) / part.n_elements
     assert 0.6 < ratio < 1.25, ratio
+
+
+@pytest.mark.parametrize("machine, part", [("four_star_compressor", "crankshaft"),
+                                           ("four_star_compressor", "rod"),
+                                           ("multi_bearing_compressor", "crankshaft")])
+def test_volume_floor_is_below_the_cad_volume(machine, part):
+    """The check's volume bound against OpenCASCADE's volume of the built solid (all fidelities)."""
+    import importlib
+
+    from crankmodal.geometry.mesh import volume_floor
+    from crankmodal.geometry.params import params_from_dict
+    from crankmodal.geometry.session import gmsh_session
+    from crankmodal.resources import load_machine
+
+    prm = params_from_dict(part, load_machine(machine)[part], where=part)
+    module = importlib.import_module(f"crankmodal.geometry.{'crankshaft' if part == 'crankshaft' else 'conrod'}")
+    builder = module.build_crankshaft if part == "crankshaft" else module.build_conrod
+    floor = volume_floor(prm)
+    for fidelity in ("full", "dechamfered", "simplified"):
+        with gmsh_session(f"{part} {fidelity}", {}) as gmsh:
+            volumes, _, _ = builder(gmsh, prm, fidelity)
+            cad = sum(gmsh.model.occ.getMass(3, v) for v in volumes)
+        assert 0.1 * cad < floor < cad, (fidelity, floor, cad)
+
+
+@pytest.mark.parametrize("scene", ["seed000_crank_report", "seed000_rod_static"])
+def test_check_refuses_an_absurd_mesh_size_of_a_built_part(scene, monkeypatch):
+    """`check` used to pass mesh_size = 1e-4; the scenes' own sizes still pass."""
+    monkeypatch.delenv("CRANKMODAL_MEMORY_LIMIT", raising=False)
+    error_line(*run_cli("check", SCENES / f"{scene}.toml", "--set", "geometry.mesh_size=1e-4"),
+               "geometry.mesh_size = 0.0001 m: at least", "tetrahedra", "use mesh_size >=")
+    assert run_cli("check", SCENES / f"{scene}.toml")[0] == 0
+
+
+def test_a_huge_part_is_refused_naming_its_dimension():
+    """journal_length = 1e30 passed check; the refusal names the dimension as well as the size
+    (the fuzz asks for the key it changed)."""
+    error_line(*run_cli("check", CRANK, "--set", "geometry.params.journal_length=1e30"),
+               "geometry.params.journal_length = 1e+30 m", "geometry.mesh_size")

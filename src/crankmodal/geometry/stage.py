@@ -104,6 +104,9 @@ def validate(raw: dict, scene) -> dict:
         origin = f" (machine {p['machine']!r}, [{p['part']}])" if p["machine"] else ""
         raise SceneError(text + origin) from None
     p["part_params"] = params
+    from .mesh import check_size_floor
+
+    check_size_floor(params, mesh_settings(p))  # run estimates again, closer, on the CAD solid
     return p
 
 
