@@ -19,6 +19,7 @@ import warnings
 import numpy as np
 import pytest
 from conftest import SCENES
+from conftest import run_cli as run_subprocess
 
 from crankmodal import cli
 from crankmodal.errors import OutputError
@@ -382,3 +383,17 @@ def test_a_huge_part_is_refused_naming_its_dimension():
     (the fuzz asks for the key it changed)."""
     error_line(*run_cli("check", CRANK, "--set", "geometry.params.journal_length=1e30"),
                "geometry.params.journal_length = 1e+30 m", "geometry.mesh_size")
+
+
+def test_a_cache_that_cannot_be_written_is_a_warning_not_an_error(tmp_path, monkeypatch):
+    """The part cache only saves time: under a file (or read-only, full) the run goes on."""
+    from test_core_cli import _bar_vtu
+
+    _bar_vtu(tmp_path / "bar.vtu", (4, 1, 1))
+    (tmp_path / "s.toml").write_text('[geometry]\nfile = "bar.vtu"\n')
+    (tmp_path / "taken").write_text("")
+    monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path / "taken" / "cache"))
+    proc = run_subprocess("run", tmp_path / "s.toml", "--out", tmp_path / "o", warnings="default")
+    assert proc.returncode == 0, proc.stderr
+    assert "crankmodal: warning: geometry.cache: cannot store the part" in proc.stderr
+    assert (tmp_path / "o" / "results.json").is_file()

@@ -138,7 +138,14 @@ def make_part(p: dict):
             name = f"{p['machine']}/{p['part']}" if p["machine"] else p["part"]
             part = build_part(p["part_params"], p["fidelity"], settings, name=name)
         if p["cache"]:
-            store_part(key, part)
+            try:
+                store_part(key, part)
+            except OSError as exc:  # the cache only saves time: a read-only or full one is no error
+                from ..errors import warn
+
+                warn(f"geometry.cache: cannot store the part in {exc.filename or 'the cache'} "
+                     f"({exc.strerror or exc}); running on without caching it "
+                     "(CRANKMODAL_CACHE names the cache folder)")
     return part, cached
 
 
