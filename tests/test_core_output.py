@@ -397,3 +397,13 @@ def test_a_cache_that_cannot_be_written_is_a_warning_not_an_error(tmp_path, monk
     assert proc.returncode == 0, proc.stderr
     assert "crankmodal: warning: geometry.cache: cannot store the part" in proc.stderr
     assert (tmp_path / "o" / "results.json").is_file()
+
+
+@pytest.mark.parametrize("argv", [["demo"], ["study", "simplification", SCENES / "seed000_crank_study.toml"]],
+                         ids=["demo", "study"])
+def test_demo_and_study_with_out_a_file(tmp_path, argv):
+    out = tmp_path / "taken"
+    out.write_text("mine")
+    error_line(*run_cli(*argv, "--out", out), str(out), "is a file, not a folder")
+    error_line(*run_cli(*argv, "--out", out / "sub"), "a parent of it is a file")
+    assert out.read_text() == "mine"
