@@ -407,3 +407,27 @@ def test_demo_and_study_with_out_a_file(tmp_path, argv):
     error_line(*run_cli(*argv, "--out", out), str(out), "is a file, not a folder")
     error_line(*run_cli(*argv, "--out", out / "sub"), "a parent of it is a file")
     assert out.read_text() == "mine"
+
+
+def test_sigterm_during_a_write_leaves_the_old_file_and_no_temporary(tmp_path, monkeypatch):
+    """`kill` (SIGTERM) while mechanism_curves.npz is half written: exit 143, the previous file
+    intact, no temporary, no results.json. Before, SIGTERM ended the process where it stood."""
+    import signal
+
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "mechanism_curves.npz").write_bytes(b"old complete arrays")
+
+    def killed(file, **arrays):
+        with open(file, "wb") as fh:
+            fh.write(b"PK\x03\x04 half")
+            os.kill(os.getpid(), signal.SIGTERM)
+            fh.write(b" more")  # the handler raises by here
+
+    monkeypatch.setattr(np, "savez_compressed", killed)
+    before = signal.getsignal(signal.SIGTERM)
+    status, stderr = run_cli("run", MECHANISM, "--out", out, "--no-figures")
+    assert status == 143 and stderr.strip().endswith("crankmodal: terminated"), stderr
+    assert signal.getsignal(signal.SIGTERM) is before  # main() restores the handler
+    assert (out / "mechanism_curves.npz").read_bytes() == b"old complete arrays"
+    assert not (out / "results.json").exists() and temporaries(out) == []

@@ -8,6 +8,7 @@ output files that cannot be written (:class:`~crankmodal.errors.OutputError`).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 
@@ -146,8 +147,39 @@ def _show_model_warnings():
     warnings.showwarning = show
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a batch system's time limit), raised where Python runs, so that the
+    output being written is cleaned up as for Ctrl-C instead of the process just ending."""
+
+
+def _on_sigterm(signum, frame):
+    raise _Terminated()
+
+
+@contextlib.contextmanager
+def _sigterm_interrupts():
+    """Turn SIGTERM into :class:`_Terminated` inside the block (main thread only: elsewhere a
+    handler cannot be set, e.g. ``main`` called from a worker thread)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``crankmodal`` console script; returns the exit status."""
+    with _sigterm_interrupts():
+        return _main(argv)
+
+
+def _main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     debug = "--debug" in argv  # until the arguments have parsed
     args = None
@@ -200,7 +232,12 @@ def main(argv: list[str] | None = None) -> int:
             exc = output_error(exc)
         print(f"crankmodal: error: {exc}", file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        # every output file is written atomically: an interrupted writer leaves no partial file
+        # (results.json of this run was removed when it started)
+        if isinstance(exc, _Terminated):
+            print("crankmodal: terminated", file=sys.stderr)
+            return 143  # 128 + SIGTERM, as a shell reports a process it ended
         print("crankmodal: interrupted", file=sys.stderr)
         return 130
     return 2
