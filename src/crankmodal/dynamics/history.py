@@ -68,12 +68,32 @@ class History:
     wall_time: float = 0.0
 
     def energy_error(self) -> float:
-        """Largest |residual| of the energy balance relative to the largest energy term."""
-        terms = [v for k, v in self.energy.items() if k != "residual"]
-        scale = max(float(np.max(np.abs(v), initial=0.0)) for v in terms)
+        """Largest |residual| of the energy balance relative to the energy exchanged in the run
+        (:meth:`energy_scale`), not to the largest energy term: a flywheel's kinetic energy or a
+        potential energy with an arbitrary zero would hide a drift of the energy that moves."""
+        scale = self.energy_scale()
+        res = float(np.max(np.abs(self.energy["residual"]), initial=0.0))
         if scale == 0.0:
-            return 0.0
-        return float(np.max(np.abs(self.energy["residual"]), initial=0.0)) / scale
+            return 0.0 if res == 0.0 else float("inf")
+        return res / scale
+
+    def energy_scale(self) -> float:
+        """Energy exchanged during the run, J.
+
+        The largest excursions of the kinetic, potential and contact elastic energies from their
+        initial values plus the cumulative |work| of the drive, the loads and the ideal
+        constraints and the energy dissipated by contact damping and friction (each work term's
+        total variation over the output samples: a lower bound of its integral of |power|).
+        """
+        e = self.energy
+        scale = 0.0
+        for k in ("kinetic", "potential", "contact_elastic"):
+            if k in e and e[k].size:
+                scale += float(np.max(np.abs(e[k] - e[k][0])))
+        for k in AUX_NAMES:
+            if k in e and e[k].size > 1:
+                scale += float(np.sum(np.abs(np.diff(e[k]))))
+        return scale
 
     def arrays(self) -> dict:
         """Flat ``{name: ndarray}`` for ``np.savez``."""

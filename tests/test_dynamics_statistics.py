@@ -1,0 +1,161 @@
+"""Per-revolution statistics against signals with known peaks, RMS and orders; the energy
+balance normalised by the energy exchanged, so a drift a flywheel would hide is flagged."""
+
+import numpy as np
+import pytest
+
+from crankmodal.dynamics import Cylinder, SolverSettings, crank_train, simulate
+from crankmodal.dynamics.stats import (
+    block_of,
+    impact_velocity_statistics,
+    per_revolution_peaks,
+    per_revolution_rms,
+    per_revolution_spectra,
+    revolution_blocks,
+    signal_statistics,
+    summarise,
+)
+from crankmodal.errors import NumericalError
+
+REV_HZ = 10.0
+
+
+def _record(n_rev=6, per_rev=360, t_start=0.05):
+    """Uniform samples from 0 to t_start + n_rev revolutions (endpoint included)."""
+    dt = 1.0 / (REV_HZ * per_rev)
+    k = round((t_start + n_rev / REV_HZ) / dt)
+    return np.arange(k + 1) * dt, t_start
+
+
+def test_revolution_blocks_count_whole_revolutions_after_the_start():
+    t, t0 = _record(n_rev=6)
+    block, n = revolution_blocks(t, t0, REV_HZ)
+    assert n == 6
+    assert np.all(block[t < t0 - 1e-12] == -1)
+    assert np.all(block[t > t0 + 6 / REV_HZ - 1e-9] == -1)      # the closing sample
+    assert np.all(np.bincount(block[block >= 0]) == 360)
+    assert list(block_of([t0 - 1e-3, t0 + 0.5 / REV_HZ, t0 + 5.99 / REV_HZ, 1.0], t0, REV_HZ, n)) \
+        == [-1, 0, 5, -1]
+
+
+def test_statistics_of_a_signal_with_known_peaks_rms_orders_and_bands():
+    t, t0 = _record(n_rev=6)
+    block, n = revolution_blocks(t, t0, REV_HZ)
+    w = 2 * np.pi * REV_HZ
+    a0, a1, a3, a20 = 50.0, 400.0, 120.0, 30.0
+    x = a0 + a1 * np.cos(w * t) + a3 * np.sin(3 * w * t + 0.7) + a20 * np.cos(20 * w * t)
+    # one event per revolution, between the samples, above the sampled signal
+    heights = np.array([700.0, 900.0, 650.0, 800.0, 1000.0, 750.0])
+    ev_t = t0 + (np.arange(6) + 0.37) / REV_HZ
+    s = signal_statistics(x, block, n, REV_HZ, block_of(ev_t, t0, REV_HZ, n), -heights)
+    pk = s["per_rev_peak"]
+    assert pk["n"] == 6
+    assert pk["mean"] == pytest.approx(heights.mean(), rel=1e-12)
+    assert pk["std"] == pytest.approx(heights.std(ddof=1), rel=1e-12)
+    assert pk["sem"] == pytest.approx(heights.std(ddof=1) / np.sqrt(6), rel=1e-12)
+    assert pk["median"] == pytest.approx(775.0) and pk["max"] == 1000.0
+    rms = np.sqrt(a0**2 + (a1**2 + a3**2 + a20**2) / 2)
+    assert s["rms"]["mean"] == pytest.approx(rms, rel=1e-12)
+    assert s["rms"]["sem"] == pytest.approx(0.0, abs=1e-9)
+    assert s["order_amplitude"]["orders"] == [1, 2, 3, 4]
+    assert s["order_amplitude"]["mean"] == pytest.approx([a1, 0.0, a3, 0.0], abs=1e-9)
+    # bands 0-100 / 100-300 / 300-1000 / 1000-3000 / above (Hz): orders 1, 3 (10, 30 Hz) and 20
+    bands = s["band_rms"]["mean"]
+    assert bands[0] == pytest.approx(np.sqrt((a1**2 + a3**2) / 2), rel=1e-12)
+    assert bands[1] == pytest.approx(a20 / np.sqrt(2), rel=1e-12)
+    assert bands[2:] == pytest.approx([0.0, 0.0, 0.0], abs=1e-9)
+    # without the events the per-revolution peak is the sampled one
+    assert per_revolution_peaks(x, block, n).max() <= a0 + a1 + a3 + a20
+
+
+def test_per_revolution_values_follow_a_growing_amplitude():
+    # amplitude 100 (1 + i) in revolution i: peaks and RMS per revolution in closed form
+    t, t0 = _record(n_rev=4, per_rev=720)
+    block, n = revolution_blocks(t, t0, REV_HZ)
+    amp = 100.0 * (1.0 + np.maximum(block, 0))
+    x = amp * np.sin(2 * np.pi * 2 * REV_HZ * t)
+    assert per_revolution_peaks(x, block, n) == pytest.approx(100.0 * np.arange(1, 5), rel=1e-12)
+    assert per_revolution_rms(x, block, n) == pytest.approx(100.0 * np.arange(1, 5) / np.sqrt(2),
+                                                            rel=1e-12)
+    amps, _ = per_revolution_spectra(x, block, n, REV_HZ)
+    assert amps[:, 1] == pytest.approx(100.0 * np.arange(1, 5), rel=1e-9)
+    assert summarise(amps[:, 1])["sem"] == pytest.approx(np.std([100, 200, 300, 400], ddof=1) / 2)
+
+
+def test_impact_velocity_quantiles_and_counts_per_revolution():
+    t0 = 0.05
+    onsets = [(t0 - 0.01, 5.0)]                                 # start-up: left out
+    v_by_rev = [[0.1, 0.2], [0.3], [0.4, 0.5, 0.6], [0.7, 0.001]]  # 0.001: grazing, left out
+    for i, vs in enumerate(v_by_rev):
+        for k, v in enumerate(vs):
+            onsets.append((t0 + (i + 0.1 + 0.2 * k) / REV_HZ, v))
+    onsets.append((t0 + 4.5 / REV_HZ, 9.0))                    # after the last whole revolution
+    s = impact_velocity_statistics(onsets, t0, REV_HZ, 4, v_min=0.01)
+    v = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])
+    assert s["p50"] == pytest.approx(np.quantile(v, 0.5))
+    assert s["p90"] == pytest.approx(np.quantile(v, 0.9))
+    assert s["max"] == pytest.approx(0.7)
+    assert s["p50_sem"] > 0.0
+    c = s["count_per_rev"]
+    assert c["mean"] == pytest.approx(7 / 4) and c["std"] == pytest.approx(np.std([2, 1, 3, 1],
+                                                                                  ddof=1))
+    assert s["max_per_rev"]["mean"] == pytest.approx((0.2 + 0.3 + 0.6 + 0.7) / 4)
+    again = impact_velocity_statistics(onsets, t0, REV_HZ, 4, v_min=0.01)
+    assert again == s                                          # bootstrap with a fixed seed
+
+
+# ---------------------------------------------------------------- energy-balance normalisation
+
+R, L = 0.035, 0.14
+
+
+class _UncountedPush:
+    """A force along the piston's velocity whose power is not reported: energy enters the
+    system without entering the balance (a stand-in for a biased force law)."""
+
+    def __init__(self, piston_load, force):
+        self.p, self.force = piston_load, force
+
+    def forces(self, sysm, t, q, qd, Q):
+        p = self.p
+        _, J, _ = sysm.frame(p.piston, p.frame, q, qd)
+        v = float(p.axis @ sysm.frame_velocity(p.piston, J, qd)[:2])
+        f = self.force * np.tanh(v / 0.01)
+        sysm.add_frame_force(Q, p.piston, J, np.array([f * p.axis[0], f * p.axis[1], 0.0]))
+        return 0.0
+
+
+def _flywheel_mech():
+    """Slider-crank with a clearance big end and a 50 kg m^2 flywheel at prescribed speed:
+    2.5 MJ of kinetic energy that never changes, against ~10^2 J exchanged per revolution."""
+    cyl = Cylinder(axis_angle=0.0, rod_length=L, rod_mass=0.9, rod_inertia=3.1e-3, rod_com=0.042,
+                   piston_mass=0.75, gas_force=lambda a: 2000.0 + 1500.0 * np.cos(a))
+    contact = {"law": "lankarani_nikravesh",
+               "law_params": {"stiffness": 1e10, "exponent": 1.5, "restitution": 0.8}}
+    return crank_train(R, [cyl], 3000.0, crank_mass=2.0, crank_inertia=50.0,
+                       clearances={"big_end_1": {"clearance": 1e-4, "journal_radius": 0.02}},
+                       contact_kw=contact)
+
+
+def _old_error(h):
+    """The normalisation before: residual over the largest energy term."""
+    terms = [v for k, v in h.energy.items() if k != "residual"]
+    return np.abs(h.energy["residual"]).max() / max(np.abs(v).max() for v in terms)
+
+
+def test_a_drift_the_flywheel_would_hide_is_flagged_and_a_correct_run_passes():
+    T = 0.02                                                   # one revolution
+    good = simulate(_flywheel_mech(), T, T / 360, SolverSettings(), energy_tolerance=1e-3)
+    assert good.energy["kinetic"].max() > 2e6
+    assert good.energy_error() < 1e-4
+    m = _flywheel_mech()
+    pl = next(ld for ld in m.system.loads if hasattr(ld, "piston"))
+    m.system.loads.append(_UncountedPush(pl, 20.0))            # ~4 R x 20 N = 2.8 J per rev
+    with pytest.raises(NumericalError, match="energy balance does not close"):
+        simulate(m, T, T / 360, SolverSettings(), energy_tolerance=1e-3)
+    bad = simulate(m, T, T / 360, SolverSettings(), energy_tolerance=None)
+    drift = np.abs(bad.energy["residual"]).max()
+    assert drift == pytest.approx(20.0 * 4 * R, rel=0.2)
+    assert bad.energy_error() == pytest.approx(drift / bad.energy_scale())
+    assert bad.energy_error() > 3e-3
+    assert _old_error(bad) < 1e-5                             # what the old check reported
