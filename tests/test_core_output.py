@@ -431,3 +431,17 @@ def test_sigterm_during_a_write_leaves_the_old_file_and_no_temporary(tmp_path, m
     assert signal.getsignal(signal.SIGTERM) is before  # main() restores the handler
     assert (out / "mechanism_curves.npz").read_bytes() == b"old complete arrays"
     assert not (out / "results.json").exists() and temporaries(out) == []
+
+
+def test_write_mesh_is_atomic_and_its_errors_name_the_users_file(tmp_path):
+    from test_core_cli import _bar_vtu
+
+    _bar_vtu(tmp_path / "bar.vtu", (4, 1, 1))
+    for name in ("m.msh", "m.xyz"):
+        (tmp_path / f"{name}.toml").write_text(f'[geometry]\nfile = "bar.vtu"\nwrite_mesh = "{name}"\n')
+    out = tmp_path / "o"
+    status, _ = run_cli("run", tmp_path / "m.msh.toml", "--out", out)
+    assert status == 0 and (out / "m.msh").stat().st_size > 0 and temporaries(out) == []
+    line = error_line(*run_cli("run", tmp_path / "m.xyz.toml", "--out", out),
+                      "geometry.write_mesh", str(out / "m.xyz"))
+    assert ".m.xyz." not in line and temporaries(out) == []

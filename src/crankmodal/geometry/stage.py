@@ -164,13 +164,16 @@ def run(p: dict, ctx) -> dict:
         from ..results import atomic_path
 
         target = ctx.out_dir / p["write_mesh"]
+        tmp_name = str(target)
         try:
             with atomic_path(target) as tmp:  # the suffix kept: meshio picks the format by it
+                tmp_name = str(tmp)
                 meshio.write(tmp, part.mesh)
         except OutputError:
             raise
         except Exception as exc:  # noqa: BLE001 - meshio: unknown extension or writer failure
-            raise SceneError(f"geometry.write_mesh: cannot write {p['write_mesh']!r} ({exc})") from None
+            why = str(exc).replace(tmp_name, str(target))  # the user's name, not the temporary's
+            raise SceneError(f"geometry.write_mesh: cannot write {p['write_mesh']!r} ({why})") from None
         out["mesh_file"] = str(target)
     q = part.quality
     qual = f", min {q['measure']} {q['min']:.3f}" if q.get("measure") else ""
