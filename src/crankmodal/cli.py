@@ -1,4 +1,4 @@
-"""Command line: ``crankmodal run | check | demo | study | machines``.
+"""Command line: ``crankmodal run | check | demo | study | sweep | machines``.
 
 User errors (:class:`~crankmodal.errors.CrankmodalError`) print one line on stderr and exit with
 status 2 (3 for a failed numerical check), without a traceback unless ``--debug`` is given; so do
@@ -67,6 +67,17 @@ def _parser() -> argparse.ArgumentParser:
     st.add_argument("--out", type=Path, help="output folder (default out/<scene name>_study)")
     st.add_argument("--no-figures", action="store_true", help="skip PNG plots")
 
+    sw = sub.add_parser("sweep", parents=[debug],
+                        help="run a parameter sweep or search of a scene on Dask (see README)")
+    sw.add_argument("sweep", type=Path, help="sweep TOML file (base scene, axes, outputs)")
+    sw.add_argument("--out", type=Path, help="sweep folder (default out/<sweep file stem>_sweep)")
+    sw.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                    help="run on this Dask scheduler instead of a local cluster")
+    sw.add_argument("--workers", type=int, metavar="N",
+                    help="worker processes of the local cluster (default: the CPU count)")
+    sw.add_argument("--retry-failed", action="store_true",
+                    help="run again the recorded points that failed")
+
     sub.add_parser("machines", parents=[debug], help="list the machine parameter files")
     return p
 
@@ -92,6 +103,25 @@ def _run(scene_file: Path, overrides, out: Path | None, figures: bool) -> int:
     results = run(scene, out_dir, figures=figures, log=lambda s: print(s, file=sys.stderr))
     print(_summary(results))
     print(f"results: {out_dir / 'results.json'}")
+    return 0
+
+
+def _sweep(args) -> int:
+    from .sweep import run_sweep
+
+    if args.workers is not None and args.workers < 1:
+        raise CrankmodalError(f"--workers: must be >= 1, got {args.workers}")
+    out_dir = args.out if args.out is not None else Path("out") / (args.sweep.stem + "_sweep")
+    res = run_sweep(args.sweep, out_dir, scheduler=args.scheduler, workers=args.workers,
+                    retry_failed=args.retry_failed, log=lambda m: print(m, file=sys.stderr))
+    print(f"sweep {res['name']}: {res['n_points']} points, {res['n_ok']} ok, "
+          f"{res['n_failed']} failed ({res['ran']} run now, {res['skipped']} already recorded) "
+          f"in {res['wall_time_s']:.1f} s")
+    if "search" in res:
+        s = res["search"]
+        print(f"search: {s['sense']} {s['objective']} = {s['best_value']!r} at "
+              f"{s['best_parameters']} (point {s['best_point']})")
+    print(f"sweep: {out_dir / 'sweep.json'}")
     return 0
 
 
@@ -216,6 +246,8 @@ def _main(argv: list[str] | None = None) -> int:
             print(res["summary"])
             print(f"study: {out_dir}")
             return 0
+        if args.command == "sweep":
+            return _sweep(args)
         if args.command == "machines":
             from .resources import list_machines
 

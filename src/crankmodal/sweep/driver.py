@@ -1,0 +1,318 @@
+"""The sweep driver: validate every point, run them on Dask, store, tabulate, search.
+
+Dask (``dask.distributed``) is the engine: a :class:`~dask.distributed.LocalCluster` of worker
+processes on this machine's cores by default (one thread each, with MKL/OpenMP/OpenBLAS held to
+one thread so PARDISO and BLAS do not oversubscribe the cores), or any cluster through its
+scheduler address or a :class:`~dask.distributed.Client`. The driver keeps a bounded number of
+points in flight (twice the workers' threads), so a sweep of thousands of points keeps the
+client's memory flat; records go to disk as they arrive.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import time
+from pathlib import Path
+
+from ..errors import CrankmodalError
+from ..results import make_out_dir, write_json_atomic
+from .execute import build_scene, execute_point, overrides_of, point_key
+from .spec import SweepSpec, load_sweep
+from .store import RecordStore
+from .table import missing_outputs, refresh_outputs, suggestion, summarise, write_csv
+
+#: The workers' environment: one BLAS/OpenMP thread per worker process.
+THREAD_ENV = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+#: Seconds to wait for a scheduler given by address.
+CONNECT_TIMEOUT_S = 3
+
+
+class SchedulerError(CrankmodalError):
+    """The Dask scheduler given by address cannot be reached."""
+
+
+def plan_tasks(spec: SweepSpec, points: list[dict], out_dir: Path, first_index: int = 0,
+               round_no: int = 0) -> list[dict]:
+    """Every point's task, each point's scene validated (:func:`crankmodal.runner.check`).
+
+    Raises
+    ------
+    CrankmodalError
+        Of the first invalid point: ``point N (key=value, ...): <the scene's error>``.
+    """
+    from ..runner import check
+
+    tasks = []
+    for i, p in enumerate(points, start=first_index):
+        ov = overrides_of(p, spec.fixed)
+        try:
+            check(build_scene(spec.base_text, str(spec.base), ov))
+        except CrankmodalError as exc:
+            where = ", ".join(f"{k}={v!r}" for k, v in p.items())
+            raise type(exc)(f"point {i} ({where}): {exc}") from None
+        key = point_key(spec.base_digest, ov)
+        tasks.append({"index": i, "key": key, "parameters": p, "overrides": ov,
+                      "base_text": spec.base_text, "base_path": str(spec.base.resolve()),
+                      "dir": str(out_dir / "points" / key), "outputs": spec.outputs,
+                      "timeout_s": spec.timeout_s, "figures": spec.figures, "round": round_no})
+    return tasks
+
+
+def check_output_sections(spec: SweepSpec, task: dict) -> None:
+    """An output whose first element is no section of the scene (nor a top-level key) is
+    refused before anything runs."""
+    scene = build_scene(spec.base_text, str(spec.base), task["overrides"])
+    top = {*scene.sections, "crankmodal_version", "scene"}
+    for o in spec.outputs:
+        if o.split(".")[0] not in top:
+            raise CrankmodalError(f"outputs: {o!r}: the scene has no [{o.split('.')[0]}] "
+                                  f"section, so no point produces it; sections: "
+                                  f"{', '.join(scene.sections)}")
+
+
+@contextlib.contextmanager
+def dask_client(client=None, scheduler: str | None = None, workers: int | None = None, log=None):
+    """The Dask client to run on: ``client`` as given, a client of ``scheduler``, or a new
+    local cluster of ``workers`` processes (default: the CPU count), closed on exit."""
+    if client is not None:
+        yield client
+        return
+    import logging
+
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            c = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
+        except Exception as exc:  # noqa: BLE001 (OSError, TimeoutError, ValueError: all one line)
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise SchedulerError(f"--scheduler {scheduler}: cannot reach the Dask scheduler "
+                                 f"({reason})") from None
+        try:
+            yield c
+        finally:
+            c.close()
+        return
+    n = workers or os.cpu_count() or 1
+    try:
+        import bokeh  # noqa: F401  (the dashboard needs it)
+        dashboard = ":0"
+    except ImportError:
+        dashboard = None
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=THREAD_ENV,
+                           dashboard_address=dashboard, silence_logs=logging.ERROR)
+    try:
+        with Client(cluster) as c:
+            yield c
+    finally:
+        cluster.close()
+
+
+def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=None) -> dict:
+    """Run the tasks whose key is not in ``done`` (updated in place with the new records).
+
+    Returns
+    -------
+    dict
+        ``ran``, ``skipped``, ``failed`` counts.
+    """
+    from dask.distributed import as_completed
+
+    from ..progress import bar
+
+    todo = [t for t in tasks if t["key"] not in done]
+    skipped = len(tasks) - len(todo)
+    threads = sum(client.nthreads().values()) or 1
+    window = 2 * threads
+    it = iter(todo)
+    inflight: dict = {}
+    ac = as_completed()
+
+    def submit(task):
+        fut = client.submit(execute_point, task, pure=False, key=f"point-{task['key']}-"
+                            f"{time.monotonic_ns()}")
+        inflight[fut.key] = (fut, task)
+        ac.add(fut)
+
+    for task in (next(it) for _ in range(min(window, len(todo)))):
+        submit(task)
+    failed = 0
+    try:
+        with bar(total=len(todo), desc="sweep", unit="pt") as pb:
+            for fut in ac:
+                task = inflight.pop(fut.key)[1]
+                try:
+                    rec = fut.result()
+                except Exception as exc:  # noqa: BLE001 (the worker died, KilledWorker): recorded
+                    rec = {"point": task["index"], "key": task["key"],
+                           "round": task["round"], "parameters": task["parameters"],
+                           "status": "error", "exit_code": None,
+                           "error": f"{type(exc).__name__}: {exc}".splitlines()[0],
+                           "outputs": dict.fromkeys(task["outputs"]), "wall_time_s": None,
+                           "dir": task["dir"]}
+                fut.release()
+                rec["dir"] = str(Path(rec["dir"]).relative_to(store.path.parent))
+                store.append(rec)
+                done[rec["key"]] = rec
+                failed += rec["status"] != "ok"
+                pb.update(1)
+                pb.set_postfix(failed=failed, refresh=False)
+                if log and rec["status"] != "ok":
+                    log(f"point {rec['point']}: {rec['status']}: {rec['error']}")
+                nxt = next(it, None)
+                if nxt is not None:
+                    submit(nxt)
+    except BaseException:
+        # an interrupt: the points in flight are lost, the recorded ones are kept
+        client.cancel([f for f, _ in inflight.values()])
+        raise
+    return {"ran": len(todo), "skipped": skipped, "failed": failed}
+
+
+def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
+              workers: int | None = None, retry_failed: bool = False, log=None) -> dict:
+    """Run a sweep (and its search) and write its records, table and ``sweep.json``.
+
+    Parameters
+    ----------
+    spec : SweepSpec or str or Path
+        The sweep, or its SWEEP.toml.
+    out_dir : str or Path
+        The sweep's folder: ``records.jsonl``, ``sweep.csv``, ``sweep.json``, ``points/<key>/``.
+        A re-run into the same folder skips the points already recorded.
+    client : dask.distributed.Client, optional
+        Run on this client's cluster (not closed here).
+    scheduler : str, optional
+        Address of a Dask scheduler (``tcp://host:port``) when no client is given.
+    workers : int, optional
+        Worker processes of the local cluster (default: the CPU count).
+    retry_failed : bool
+        Run again the recorded points that failed (error, timeout).
+    log : callable, optional
+        ``log(str)`` for progress lines.
+
+    Returns
+    -------
+    dict
+        What ``sweep.json`` holds.
+
+    Raises
+    ------
+    CrankmodalError
+        Bad sweep or point (before anything runs), unreachable scheduler (SchedulerError), an
+        output no successful point produced (after the run; the records are kept, so fixing
+        ``outputs`` and re-running recomputes nothing).
+    """
+    t0 = time.perf_counter()
+    spec = spec if isinstance(spec, SweepSpec) else load_sweep(spec)
+    out_dir = Path(out_dir)
+    tasks = plan_tasks(spec, spec.points(), out_dir.resolve())  # every point checked first
+    check_output_sections(spec, tasks[0])
+    out_dir = make_out_dir(out_dir)
+    for stale in ("sweep.json", "sweep.csv"):  # a failed re-run must not leave old tables
+        (out_dir / stale).unlink(missing_ok=True)
+    store = RecordStore(out_dir / "records.jsonl")
+    done = store.read()
+    if retry_failed:
+        done = {k: r for k, r in done.items() if r.get("status") == "ok"}
+    stats = {"ran": 0, "skipped": 0, "failed": 0}
+    info: dict = {}
+    rounds = []
+    keys = [t["key"] for t in tasks]
+    with dask_client(client, scheduler, workers, log) as c:
+        info = {"scheduler": c.scheduler.address, "workers": len(c.nthreads()),
+                "threads": sum(c.nthreads().values()), "dashboard": _dashboard(c)}
+        if log:
+            log(f"dask: {info['workers']} workers at {info['scheduler']}"
+                + (f", dashboard {info['dashboard']}" if info["dashboard"] else ""))
+        _add(stats, run_tasks(c, tasks, store, done, log))
+        if spec.search:
+            rounds, more = _search(spec, c, tasks, store, done, out_dir.resolve(), log, stats)
+            keys += more
+    records = [refresh_outputs(done[k], spec.outputs, out_dir) for k in dict.fromkeys(keys)]
+    records.sort(key=lambda r: (r.get("round", 0), r["point"]))
+    missing = missing_outputs(records, spec.outputs)
+    if missing:
+        ok = next(r for r in records if r["status"] == "ok")
+        raise CrankmodalError(
+            f"outputs: {missing[0]!r} is in no successful point's results.json"
+            f"{suggestion(ok, out_dir, missing[0])}; fix outputs and re-run (finished points "
+            "are kept and not recomputed)")
+    axis_keys = [a.key for a in spec.axes]
+    write_csv(out_dir / "sweep.csv", records, axis_keys, spec.outputs)
+    by_status: dict = {}
+    for r in records:
+        by_status[r["status"]] = by_status.get(r["status"], 0) + 1
+    summary = {
+        "name": spec.name, "base": str(spec.base), "mode": spec.mode,
+        "axes": [{"key": a.key, "values": list(a.values), "start": a.start, "stop": a.stop,
+                  "log": a.log} for a in spec.axes],
+        "set": spec.fixed, "outputs": spec.outputs, "timeout_s": spec.timeout_s,
+        "n_points": len(records), "status_counts": by_status,
+        "n_ok": by_status.get("ok", 0), "n_failed": len(records) - by_status.get("ok", 0),
+        "ran": stats["ran"], "skipped": stats["skipped"],
+        "wall_time_s": time.perf_counter() - t0, "dask": info,
+        "files": {"records": "records.jsonl", "table": "sweep.csv", "points": "points/"},
+        "output_ranges": summarise(records, spec.outputs),
+    }
+    if spec.search:
+        summary["search"] = _search_result(spec, records, rounds)
+    write_json_atomic(out_dir / "sweep.json", summary)
+    return summary
+
+
+def _add(total: dict, part: dict) -> None:
+    for k in total:
+        total[k] += part[k]
+
+
+def _dashboard(client) -> str | None:
+    try:
+        import bokeh  # noqa: F401
+    except ImportError:
+        return None
+    return getattr(client, "dashboard_link", None)
+
+
+def _search(spec, client, tasks, store, done, out_dir, log, stats):
+    """Refinement rounds of the search; returns the per-round summary and the new keys."""
+    from .search import best, initial_steps, refine
+
+    s = spec.search
+    steps = initial_steps(spec.axes)
+    current = [done[t["key"]] for t in tasks]
+    keys, rounds = [], []
+    n_next = len(tasks)
+    top = best(current, s["objective"], s["sense"])
+    rounds.append({"round": 0, "points": len(tasks), "best_point": top and top["point"],
+                   "best_value": top and top["outputs"][s["objective"]]})
+    for r in range(1, s["rounds"] + 1):
+        if top is None:
+            break
+        pts, steps = refine(spec.axes, top["parameters"], steps, s["num"])
+        new = plan_tasks(spec, pts, out_dir, n_next, r)
+        n_next += len(new)
+        _add(stats, run_tasks(client, new, store, done, log))
+        keys += [t["key"] for t in new]
+        current += [done[t["key"]] for t in new]
+        top = best(current, s["objective"], s["sense"])
+        rounds.append({"round": r, "points": len(new), "best_point": top and top["point"],
+                       "best_value": top and top["outputs"][s["objective"]],
+                       "step": dict(steps)})
+        if log:
+            log(f"search round {r}: best {s['objective']} = {rounds[-1]['best_value']!r} at "
+                f"{top['parameters']}")
+    return rounds, keys
+
+
+def _search_result(spec, records, rounds) -> dict:
+    from .search import best
+
+    s = spec.search
+    top = best(records, s["objective"], s["sense"])
+    if top is None:
+        raise CrankmodalError(f"search: no point produced a number for {s['objective']!r}")
+    return {"objective": s["objective"], "sense": s["sense"], "best_point": top["point"],
+            "best_parameters": top["parameters"], "best_value": top["outputs"][s["objective"]],
+            "rounds": rounds}

@@ -1,0 +1,233 @@
+"""Sweeps on Dask (crankmodal.sweep): point generation, bad input, a local 2-worker cluster,
+failures recorded, resumption after a kill, and a search against a closed-form optimum."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from crankmodal.cli import main
+from crankmodal.errors import CrankmodalError, SceneError
+from crankmodal.sweep import load_sweep, run_sweep
+from crankmodal.sweep.axes import generate, parse_axis
+from crankmodal.sweep.driver import plan_tasks
+from crankmodal.sweep.store import RecordStore
+
+ROOT = Path(__file__).resolve().parents[1]
+MECH = ROOT / "scenes" / "four_star_mechanism.toml"
+THROW = "mechanism.cylinders.0.throw_angle_deg"
+F1 = "mechanism.first_order_force_max_n"
+
+
+def write_sweep(tmp_path, text, name="sw.toml"):
+    p = tmp_path / name
+    p.write_text(f'base = "{MECH}"\n' + text)
+    return p
+
+
+@pytest.fixture(scope="module")
+def client():
+    """One local cluster of two worker processes for the module (as the CLI makes it)."""
+    pytest.importorskip("dask.distributed")
+    from crankmodal.sweep.driver import dask_client
+
+    with dask_client(workers=2) as c:
+        yield c
+
+
+# ---------------------------------------------------------------- generation
+
+
+def test_grid_zip_range_and_log_axes():
+    a = parse_axis("x", {"start": 0.0, "stop": 1.0, "num": 3})
+    b = parse_axis("y", [10, 20])
+    assert a.values == (0.0, 0.5, 1.0)
+    pts = generate([a, b], "grid")
+    assert len(pts) == 6 and pts[1] == {"x": 0.0, "y": 20}
+    c = parse_axis("z", {"start": 1e-5, "stop": 1e-3, "num": 3, "log": True})
+    assert np.allclose(c.values, [1e-5, 1e-4, 1e-3])
+    z = generate([a, parse_axis("w", [1, 2, 3])], "zip")
+    assert [p["w"] for p in z] == [1, 2, 3] and [p["x"] for p in z] == [0.0, 0.5, 1.0]
+    with pytest.raises(SceneError, match="zip"):
+        generate([a, b], "zip")
+    assert parse_axis("n", {"start": 360, "stop": 720, "num": 3}).values == (360, 540, 720)
+
+
+def test_lhs_is_stratified_and_random_is_seeded():
+    a = parse_axis("x", {"start": 0.0, "stop": 10.0})
+    b = parse_axis("y", {"start": 1.0, "stop": 100.0, "log": True})
+    pts = generate([a, b], "lhs", samples=8, seed=3)
+    # one sample in each eighth of each axis (log-eighths for the log axis)
+    assert sorted(int(p["x"] / 10 * 8) for p in pts) == list(range(8))
+    assert sorted(int(np.log10(p["y"]) / 2 * 8) for p in pts) == list(range(8))
+    r1 = generate([a, b], "random", samples=5, seed=1)
+    assert r1 == generate([a, b], "random", samples=5, seed=1)
+    assert all(0 <= p["x"] <= 10 and 1 <= p["y"] <= 100 for p in r1)
+
+
+# ---------------------------------------------------------------- bad input (nothing runs)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("[axes]\nmechanism.speed_rpm = []\n", "axes.mechanism.speed_rpm: empty axis"),
+    ("outputs = []\n", "axes: no axes"),
+    ("[axes]\nmechanism.speed_rpm = {start = 1, num = 3}\n", "needs stop"),
+    ("mode = 'zip'\n[axes]\na.b = [1, 2]\nc.d = [1]\n", "zip"),
+    ("modes = 'grid'\n[axes]\na.b = [1]\n", "modes: unknown sweep key"),
+    ("mode = 'lhs'\n[axes]\na.b = {start = 0, stop = 1}\n", "samples"),
+])
+def test_bad_sweep_file_is_one_line(tmp_path, text, match):
+    with pytest.raises(SceneError, match=match):
+        run_sweep(load_sweep(write_sweep(tmp_path, text)), tmp_path / "out")
+    assert not (tmp_path / "out" / "records.jsonl").exists()
+
+
+def test_bad_point_named_before_anything_runs(tmp_path, capsys):
+    sw = write_sweep(tmp_path, "[axes]\nmechanism.speed_rpm = [1000, -5]\n"
+                     "mechanism.no_such_key = [1]\n")
+    assert main(["sweep", str(sw), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "point 0 (" in err and "no_such_key" in err
+    sw = write_sweep(tmp_path, "[axes]\nmechanism.speed_rpm = [1000, -5]\n")
+    assert main(["sweep", str(sw), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "point 1 (mechanism.speed_rpm=-5)" in err and "mechanism.speed_rpm" in err
+    assert not (tmp_path / "o" / "records.jsonl").exists()
+
+
+def test_output_of_a_missing_section_refused(tmp_path):
+    sw = write_sweep(tmp_path, "outputs = ['dynamics.x']\n[axes]\nmechanism.speed_rpm = [1000]\n")
+    with pytest.raises(CrankmodalError, match=r"outputs: 'dynamics.x'.*no \[dynamics\]"):
+        run_sweep(sw, tmp_path / "o")
+
+
+def test_unreachable_scheduler_is_exit_2_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr("crankmodal.sweep.driver.CONNECT_TIMEOUT_S", 1)
+    sw = write_sweep(tmp_path, "[axes]\nmechanism.speed_rpm = [1000]\n")
+    t0 = time.perf_counter()
+    rc = main(["sweep", str(sw), "--out", str(tmp_path / "o"), "--scheduler",
+               "tcp://127.0.0.1:1"])
+    assert rc == 2 and time.perf_counter() - t0 < 30
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "tcp://127.0.0.1:1" in err[0] and "cannot reach" in err[0]
+
+
+# ---------------------------------------------------------------- on a local cluster
+
+
+def test_small_sweep_on_two_workers(tmp_path, client):
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}', 'mechanism.peak_acceleration_m_s2.0']\n"
+                     "[axes]\nmechanism.speed_rpm = [1000, 2000]\n"
+                     f"{THROW} = {{start = 0, stop = 180, num = 3}}\n")
+    res = run_sweep(sw, tmp_path / "o", client=client)
+    assert res["n_points"] == 6 and res["n_ok"] == 6 and res["ran"] == 6
+    rows = (tmp_path / "o" / "sweep.csv").read_text().splitlines()
+    assert len(rows) == 7 and F1 in rows[0]
+    recs = RecordStore(tmp_path / "o" / "records.jsonl").read()
+    assert len(recs) == 6
+    # first-order force of the four-star scales with speed^2; with both throws aligned it is
+    # 2 m_rec r w^2 (seed 000 Table 1), read from the mechanism's own results.json
+    by = {(r["parameters"]["mechanism.speed_rpm"], r["parameters"][THROW]): r for r in recs.values()}
+    f1000, f2000 = by[(1000, 0)]["outputs"][F1], by[(2000, 0)]["outputs"][F1]
+    assert f2000 / f1000 == pytest.approx(4.0, rel=1e-12)
+    assert by[(1000, 0)]["outputs"]["mechanism.peak_acceleration_m_s2.0"] > 0
+    assert json.loads((tmp_path / "o" / "sweep.json").read_text())["n_ok"] == 6
+    # the same sweep again runs nothing
+    again = run_sweep(sw, tmp_path / "o", client=client)
+    assert again["ran"] == 0 and again["skipped"] == 6 and again["n_ok"] == 6
+
+
+def test_failing_points_recorded_and_sweep_goes_on(tmp_path, client):
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\ntimeout_s = 1.5\n"
+                     "[axes]\nmechanism.n_points = [360, 100000, 720, 1440]\n")
+    spec = load_sweep(sw)
+    tasks = plan_tasks(spec, spec.points(), (tmp_path / "o").resolve())
+    # point 2's output folder is a file: an OutputError (exit 2) inside the run
+    Path(tasks[2]["dir"]).parent.mkdir(parents=True)
+    Path(tasks[2]["dir"]).write_text("in the way")
+    res = run_sweep(spec, tmp_path / "o", client=client)
+    recs = {r["point"]: r for r in RecordStore(tmp_path / "o" / "records.jsonl").read().values()}
+    assert res["n_points"] == 4 and res["n_ok"] == 2
+    assert recs[0]["status"] == recs[3]["status"] == "ok"
+    assert recs[1]["status"] == "timeout" and "timeout_s = 1.5" in recs[1]["error"]
+    assert recs[2]["status"] == "error" and recs[2]["exit_code"] == 2
+    assert "\n" not in recs[2]["error"] and recs[2]["outputs"][F1] is None
+    assert res["status_counts"] == {"ok": 2, "timeout": 1, "error": 1}
+
+
+def test_output_no_point_produces_after_the_run(tmp_path, client):
+    sw = write_sweep(tmp_path, "outputs = ['mechanism.shaking_force_maxx_n']\n"
+                     "[axes]\nmechanism.speed_rpm = [1000, 1200]\n")
+    with pytest.raises(CrankmodalError, match="nearest: mechanism.shaking_force_max_n"):
+        run_sweep(sw, tmp_path / "o", client=client)
+    assert not (tmp_path / "o" / "sweep.json").exists()
+    # fixed outputs: the recorded points are re-read, not recomputed
+    sw.write_text(sw.read_text().replace("maxx", "max"))
+    res = run_sweep(sw, tmp_path / "o", client=client)
+    assert res["ran"] == 0 and res["output_ranges"]["mechanism.shaking_force_max_n"]["n"] == 2
+
+
+def test_search_finds_the_closed_form_optimum(tmp_path, client):
+    """Maximise the four-star's first-order force over cylinder 1's throw angle phi. Seed 000
+    Table 1: each cylinder's first-order force is m r w^2 cos(theta + phi_i - beta_i) along its
+    axis; with banks 0/180/270/90 deg the resultant is m r w^2 (2 sin theta, cos theta +
+    cos(theta + phi)), whose maximum over theta and phi is found here by scipy, independently."""
+    from scipy.optimize import minimize_scalar
+
+    th = np.linspace(0, 2 * np.pi, 20001)
+
+    def peak(phi_deg):
+        f = np.radians(phi_deg)
+        return np.max(np.hypot(2 * np.sin(th), np.cos(th) + np.cos(th + f))) / 2
+
+    opt = minimize_scalar(lambda p: -peak(p), bounds=(0, 180), method="bounded",
+                          options={"xatol": 1e-6})
+    phi_star, ratio_star = opt.x, peak(opt.x)
+    sw = write_sweep(tmp_path, f"[axes]\n{THROW} = {{start = 0.0, stop = 180.0, num = 7}}\n"
+                     f"[search]\nmaximize = '{F1}'\nrounds = 4\nnum = 5\n")
+    res = run_sweep(sw, tmp_path / "o", client=client)
+    s = res["search"]
+    f_aligned = res["output_ranges"][F1]["min"]  # phi = 0 and 180: 2 m r w^2
+    assert f_aligned == pytest.approx(2 * 1.76 * 0.035 * (1480 * np.pi / 30) ** 2, rel=1e-9)
+    step = 30 / 2 ** 4
+    assert abs(s["best_parameters"][THROW] - phi_star) <= step
+    assert s["best_value"] / f_aligned == pytest.approx(ratio_star, rel=2e-4)
+    assert len(s["rounds"]) == 5 and s["rounds"][-1]["step"][THROW] == pytest.approx(step)
+
+
+# ---------------------------------------------------------------- resumption after a kill
+
+
+def test_resume_after_kill_runs_only_the_missing_points(tmp_path, client):
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n"
+                     "[axes]\nmechanism.speed_rpm = {start = 900, stop = 2000, num = 12}\n")
+    out = tmp_path / "o"
+    env = {**os.environ, "CRANKMODAL_QUIET": "1"}
+    proc = subprocess.Popen([sys.executable, "-m", "crankmodal.cli", "sweep", str(sw), "--out",
+                             str(out), "--workers", "1"], env=env, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    rec = out / "records.jsonl"
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            if rec.is_file() and rec.read_text().count("\n") >= 3:
+                break
+            time.sleep(0.05)
+        os.killpg(proc.pid, signal.SIGKILL)  # the driver, its cluster and workers
+    finally:
+        proc.wait()
+    kept = len(RecordStore(rec).read())
+    assert 3 <= kept < 12
+    with open(rec, "a") as fh:  # a line cut by the kill
+        fh.write('{"point": 11, "key": "tru')
+    res = run_sweep(sw, out, client=client)
+    assert res["ran"] == 12 - kept and res["skipped"] == kept and res["n_ok"] == 12
+    assert len(RecordStore(rec).read()) == 12
