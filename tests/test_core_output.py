@@ -445,3 +445,19 @@ def test_write_mesh_is_atomic_and_its_errors_name_the_users_file(tmp_path):
     line = error_line(*run_cli("run", tmp_path / "m.xyz.toml", "--out", out),
                       "geometry.write_mesh", str(out / "m.xyz"))
     assert ".m.xyz." not in line and temporaries(out) == []
+
+
+def test_write_atomic_writes_utf8_whatever_the_locale(tmp_path):
+    """Reports carry −, † and ²; in an ASCII locale (LC_ALL=C without Python's UTF-8 mode) they
+    raised UnicodeEncodeError."""
+    import subprocess
+    import sys
+
+    text = "f − f_ref †, 2.5 m²\n"
+    env = dict(os.environ, LC_ALL="C", LANG="C", PYTHONUTF8="0", PYTHONCOERCECLOCALE="0")
+    code = ("import sys; from crankmodal.results import write_atomic; "
+            f"write_atomic(sys.argv[1], {text!a})")  # ascii(): no locale decoding of argv
+    proc = subprocess.run([sys.executable, "-c", code, str(tmp_path / "r.md")], env=env,
+                          capture_output=True, text=True, encoding="utf-8", check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "r.md").read_bytes() == text.encode("utf-8")

@@ -106,7 +106,7 @@ def atomic_path(path: str | Path):
     except BaseException as exc:
         try:
             os.unlink(tmp)
-        except FileNotFoundError:
+        except OSError:  # gone already, or the folder turned read-only: the first error counts
             pass
         if isinstance(exc, OSError):
             raise output_error(exc, path) from None
@@ -116,10 +116,13 @@ def atomic_path(path: str | Path):
 def write_atomic(path: str | Path, data: bytes | str) -> Path:
     """Write ``data`` to ``path`` atomically (see :func:`atomic_path`).
 
-    A reader sees either the old file, or the complete new one, never a partial write.
+    A reader sees either the old file, or the complete new one, never a partial write. Text is
+    written as UTF-8 whatever the locale (reports carry −, †, ², ...).
     """
     path = Path(path)
-    with atomic_path(path) as tmp, open(tmp, "wb" if isinstance(data, bytes) else "w") as fh:
+    if isinstance(data, str):
+        data = data.encode("utf-8")
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         fh.write(data)
     return path
 

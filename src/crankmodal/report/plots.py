@@ -29,7 +29,7 @@ def _figure(figsize=(7.0, 4.8)):
 
 
 def _write_csv(path: Path, header, rows) -> Path:
-    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
+    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(header)
         w.writerows(rows)

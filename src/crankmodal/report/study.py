@@ -359,7 +359,7 @@ def write_study(study: SimplificationStudy, out_dir, measured_hz=None, title="",
     paths = {}
     n = len(study.reference_hz)
     csv_path = out_dir / "study.csv"
-    with atomic_path(csv_path) as tmp, open(tmp, "w", newline="") as fh:
+    with atomic_path(csv_path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["fidelity", "order", "mesh_size_m", "n_elements", "n_nodes", "n_dofs",
                     "mesh_time_s", "solve_time_s", "wall_time_s", "error", "pareto",
