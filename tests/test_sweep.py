@@ -140,9 +140,18 @@ def test_small_sweep_on_two_workers(tmp_path, client):
     assert f2000 / f1000 == pytest.approx(4.0, rel=1e-12)
     assert by[(1000, 0)]["outputs"]["mechanism.peak_acceleration_m_s2.0"] > 0
     assert json.loads((tmp_path / "o" / "sweep.json").read_text())["n_ok"] == 6
-    # the same sweep again runs nothing
-    again = run_sweep(sw, tmp_path / "o", client=client)
+    assert (tmp_path / "o" / f"sweep_{F1}.png").read_bytes().endswith(b"IEND\xaeB`\x82")
+    # the same sweep again runs nothing, and starts no cluster
+    again = run_sweep(sw, tmp_path / "o", client=None, scheduler="tcp://127.0.0.1:1")
     assert again["ran"] == 0 and again["skipped"] == 6 and again["n_ok"] == 6
+    assert again["dask"] == {}
+
+
+def test_run_never_imports_dask(tmp_path):
+    code = ("import sys; from crankmodal.cli import main; "
+            f"rc = main(['--quiet', 'run', r'{MECH}', '--out', r'{tmp_path}', '--no-figures']); "
+            "assert rc == 0 and 'dask' not in sys.modules and 'distributed' not in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
 
 
 def test_failing_points_recorded_and_sweep_goes_on(tmp_path, client):

@@ -77,6 +77,7 @@ def _parser() -> argparse.ArgumentParser:
                     help="worker processes of the local cluster (default: the CPU count)")
     sw.add_argument("--retry-failed", action="store_true",
                     help="run again the recorded points that failed")
+    sw.add_argument("--no-figures", action="store_true", help="skip the sweep_<output>.png maps")
 
     sub.add_parser("machines", parents=[debug], help="list the machine parameter files")
     return p
@@ -113,7 +114,8 @@ def _sweep(args) -> int:
         raise CrankmodalError(f"--workers: must be >= 1, got {args.workers}")
     out_dir = args.out if args.out is not None else Path("out") / (args.sweep.stem + "_sweep")
     res = run_sweep(args.sweep, out_dir, scheduler=args.scheduler, workers=args.workers,
-                    retry_failed=args.retry_failed, log=lambda m: print(m, file=sys.stderr))
+                    retry_failed=args.retry_failed, figures=not args.no_figures,
+                    log=lambda m: print(m, file=sys.stderr))
     print(f"sweep {res['name']}: {res['n_points']} points, {res['n_ok']} ok, "
           f"{res['n_failed']} failed ({res['ran']} run now, {res['skipped']} already recorded) "
           f"in {res['wall_time_s']:.1f} s")

@@ -109,8 +109,30 @@ def dask_client(client=None, scheduler: str | None = None, workers: int | None =
         cluster.close()
 
 
+class LazyClient:
+    """The Dask client, connected (or its local cluster started) on first use: a re-run whose
+    points are all recorded starts no cluster."""
+
+    def __init__(self, stack: contextlib.ExitStack, client=None, scheduler=None, workers=None,
+                 log=None):
+        self.stack, self.args, self.log = stack, (client, scheduler, workers, log), log
+        self.client, self.info = None, {}
+
+    def get(self):
+        if self.client is None:
+            c = self.client = self.stack.enter_context(dask_client(*self.args))
+            self.info = {"scheduler": c.scheduler.address, "workers": len(c.nthreads()),
+                         "threads": sum(c.nthreads().values()), "dashboard": _dashboard(c)}
+            if self.log:
+                self.log(f"dask: {self.info['workers']} workers at {self.info['scheduler']}"
+                         + (f", dashboard {self.info['dashboard']}"
+                            if self.info["dashboard"] else ""))
+        return self.client
+
+
 def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=None) -> dict:
-    """Run the tasks whose key is not in ``done`` (updated in place with the new records).
+    """Run the tasks whose key is not in ``done`` (updated in place with the new records) on
+    ``client`` (a Dask client or a :class:`LazyClient`).
 
     Returns
     -------
@@ -123,6 +145,10 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
 
     todo = [t for t in tasks if t["key"] not in done]
     skipped = len(tasks) - len(todo)
+    if not todo:
+        return {"ran": 0, "skipped": skipped, "failed": 0}
+    if isinstance(client, LazyClient):
+        client = client.get()
     threads = sum(client.nthreads().values()) or 1
     window = 2 * threads
     it = iter(todo)
@@ -171,7 +197,8 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
 
 
 def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
-              workers: int | None = None, retry_failed: bool = False, log=None) -> dict:
+              workers: int | None = None, retry_failed: bool = False, figures: bool = True,
+              log=None) -> dict:
     """Run a sweep (and its search) and write its records, table and ``sweep.json``.
 
     Parameters
@@ -189,6 +216,8 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
         Worker processes of the local cluster (default: the CPU count).
     retry_failed : bool
         Run again the recorded points that failed (error, timeout).
+    figures : bool
+        Write ``sweep_<output>.png`` maps (:mod:`crankmodal.sweep.figures`).
     log : callable, optional
         ``log(str)`` for progress lines.
 
@@ -210,26 +239,23 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
     tasks = plan_tasks(spec, spec.points(), out_dir.resolve())  # every point checked first
     check_output_sections(spec, tasks[0])
     out_dir = make_out_dir(out_dir)
-    for stale in ("sweep.json", "sweep.csv"):  # a failed re-run must not leave old tables
+    for stale in ("sweep.json", "sweep.csv", *(p.name for p in out_dir.glob("sweep_*.png"))):
+        # a failed re-run must not leave an old table or map looking like its answer
         (out_dir / stale).unlink(missing_ok=True)
     store = RecordStore(out_dir / "records.jsonl")
     done = store.read()
     if retry_failed:
         done = {k: r for k, r in done.items() if r.get("status") == "ok"}
     stats = {"ran": 0, "skipped": 0, "failed": 0}
-    info: dict = {}
     rounds = []
     keys = [t["key"] for t in tasks]
-    with dask_client(client, scheduler, workers, log) as c:
-        info = {"scheduler": c.scheduler.address, "workers": len(c.nthreads()),
-                "threads": sum(c.nthreads().values()), "dashboard": _dashboard(c)}
-        if log:
-            log(f"dask: {info['workers']} workers at {info['scheduler']}"
-                + (f", dashboard {info['dashboard']}" if info["dashboard"] else ""))
-        _add(stats, run_tasks(c, tasks, store, done, log))
+    with contextlib.ExitStack() as stack:
+        lazy = LazyClient(stack, client, scheduler, workers, log)
+        _add(stats, run_tasks(lazy, tasks, store, done, log))
         if spec.search:
-            rounds, more = _search(spec, c, tasks, store, done, out_dir.resolve(), log, stats)
+            rounds, more = _search(spec, lazy, tasks, store, done, out_dir.resolve(), log, stats)
             keys += more
+        info = lazy.info
     records = [refresh_outputs(done[k], spec.outputs, out_dir) for k in dict.fromkeys(keys)]
     records.sort(key=lambda r: (r.get("round", 0), r["point"]))
     missing = missing_outputs(records, spec.outputs)
@@ -258,6 +284,12 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
     }
     if spec.search:
         summary["search"] = _search_result(spec, records, rounds)
+    if figures:
+        from .figures import sweep_maps
+
+        summary["files"]["figures"] = sweep_maps(
+            records, axis_keys, spec.outputs, out_dir, {a.key for a in spec.axes if a.log},
+            summary.get("search", {}).get("best_point"))
     write_json_atomic(out_dir / "sweep.json", summary)
     return summary
 
