@@ -240,3 +240,16 @@ def test_resume_after_kill_runs_only_the_missing_points(tmp_path, client):
     res = run_sweep(sw, out, client=client)
     assert res["ran"] == 12 - kept and res["skipped"] == kept and res["n_ok"] == 12
     assert len(RecordStore(rec).read()) == 12
+
+
+@pytest.mark.parametrize("sweep_file", sorted((ROOT / "scenes" / "sweeps").glob("*.toml")),
+                         ids=lambda p: p.stem)
+def test_study_sweeps_validate(sweep_file, tmp_path):
+    """The prepared study sweeps: every coarse point's scene checks, every output's section is
+    in the scene (nothing runs)."""
+    from crankmodal.sweep.driver import check_output_sections
+
+    spec = load_sweep(sweep_file)
+    tasks = plan_tasks(spec, spec.points(), tmp_path)
+    check_output_sections(spec, tasks[0])
+    assert len(tasks) >= 4
