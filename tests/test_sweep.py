@@ -200,6 +200,8 @@ def test_search_finds_the_closed_form_optimum(tmp_path, client):
     opt = minimize_scalar(lambda p: -peak(p), bounds=(0, 180), method="bounded",
                           options={"xatol": 1e-6})
     phi_star, ratio_star = opt.x, peak(opt.x)
+    assert phi_star == pytest.approx(np.degrees(np.arccos(1 / 3)), abs=0.02)  # cos phi* = 1/3
+    assert ratio_star == pytest.approx(2 / np.sqrt(3), rel=1e-7)
     sw = write_sweep(tmp_path, f"[axes]\n{THROW} = {{start = 0.0, stop = 180.0, num = 7}}\n"
                      f"[search]\nmaximize = '{F1}'\nrounds = 4\nnum = 5\n")
     res = run_sweep(sw, tmp_path / "o", client=client)
@@ -210,6 +212,8 @@ def test_search_finds_the_closed_form_optimum(tmp_path, client):
     assert abs(s["best_parameters"][THROW] - phi_star) <= step
     assert s["best_value"] / f_aligned == pytest.approx(ratio_star, rel=2e-4)
     assert len(s["rounds"]) == 5 and s["rounds"][-1]["step"][THROW] == pytest.approx(step)
+    print(f"search: phi {s['best_parameters'][THROW]:.3f} deg (closed form {phi_star:.3f}), "
+          f"force ratio {s['best_value'] / f_aligned:.6f} ({ratio_star:.6f})")
 
 
 # ---------------------------------------------------------------- resumption after a kill
