@@ -147,6 +147,15 @@ def test_small_sweep_on_two_workers(tmp_path, client):
     assert again["dask"] == {}
 
 
+def test_relative_out_folder(tmp_path, client, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n[axes]\nmechanism.speed_rpm = [1000]\n")
+    res = run_sweep(sw, Path("rel") / "o", client=client, figures=False)
+    assert res["n_ok"] == 1
+    rec = next(iter(RecordStore(tmp_path / "rel" / "o" / "records.jsonl").read().values()))
+    assert (tmp_path / "rel" / "o" / rec["dir"] / "results.json").is_file()
+
+
 def test_run_never_imports_dask(tmp_path):
     code = ("import sys; from crankmodal.cli import main; "
             f"rc = main(['--quiet', 'run', r'{MECH}', '--out', r'{tmp_path}', '--no-figures']); "

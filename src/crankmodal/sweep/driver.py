@@ -242,7 +242,7 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
     for stale in ("sweep.json", "sweep.csv", *(p.name for p in out_dir.glob("sweep_*.png"))):
         # a failed re-run must not leave an old table or map looking like its answer
         (out_dir / stale).unlink(missing_ok=True)
-    store = RecordStore(out_dir / "records.jsonl")
+    store = RecordStore(out_dir.resolve() / "records.jsonl")  # point dirs are absolute
     done = store.read()
     if retry_failed:
         done = {k: r for k, r in done.items() if r.get("status") == "ok"}
