@@ -120,6 +120,14 @@ def test_unreachable_scheduler_is_exit_2_one_line(tmp_path, capsys, monkeypatch)
     assert len(err) == 1 and "tcp://127.0.0.1:1" in err[0] and "cannot reach" in err[0]
 
 
+def test_without_dask_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # import fails as if absent
+    sw = write_sweep(tmp_path, "[axes]\nmechanism.speed_rpm = [1000]\n")
+    assert main(["sweep", str(sw), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pip install 'crankmodal[sweep]'" in err[0]
+
+
 # ---------------------------------------------------------------- on a local cluster
 
 

@@ -80,8 +80,11 @@ def dask_client(client=None, scheduler: str | None = None, workers: int | None =
         return
     import logging
 
-    from dask.distributed import Client, LocalCluster
-
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        raise CrankmodalError("crankmodal sweep runs on Dask, which is not installed: "
+                              "pip install 'crankmodal[sweep]' (or 'dask[distributed]')") from None
     if scheduler:
         try:
             c = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
@@ -139,8 +142,6 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
     dict
         ``ran``, ``skipped``, ``failed`` counts.
     """
-    from dask.distributed import as_completed
-
     from ..progress import bar
 
     todo = [t for t in tasks if t["key"] not in done]
@@ -149,6 +150,7 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
         return {"ran": 0, "skipped": skipped, "failed": 0}
     if isinstance(client, LazyClient):
         client = client.get()
+    from dask.distributed import as_completed
     threads = sum(client.nthreads().values()) or 1
     window = 2 * threads
     it = iter(todo)
