@@ -164,6 +164,19 @@ def test_relative_out_folder(tmp_path, client, monkeypatch):
     assert (tmp_path / "rel" / "o" / rec["dir"] / "results.json").is_file()
 
 
+def test_text_axis_and_three_axes_maps(tmp_path, client):
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n"
+                     "[axes]\nmechanism.harmonics = ['series', 'fourier']\n")
+    res = run_sweep(sw, tmp_path / "a", client=client)
+    assert res["files"]["figures"] == [f"sweep_{F1}.png"]
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\nmode = 'lhs'\nsamples = 4\n[axes]\n"
+                     "mechanism.speed_rpm = {start = 900.0, stop = 1500.0}\n"
+                     f"{THROW} = {{start = 0.0, stop = 90.0}}\n"
+                     "mechanism.n_points = [360, 720]\n", name="lhs.toml")
+    res = run_sweep(sw, tmp_path / "b", client=client)
+    assert res["n_ok"] == 4 and (tmp_path / "b" / f"sweep_{F1}.png").is_file()
+
+
 def test_run_never_imports_dask(tmp_path):
     code = ("import sys; from crankmodal.cli import main; "
             f"rc = main(['--quiet', 'run', r'{MECH}', '--out', r'{tmp_path}', '--no-figures']); "

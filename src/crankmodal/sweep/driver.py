@@ -291,7 +291,8 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
 
         summary["files"]["figures"] = sweep_maps(
             records, axis_keys, spec.outputs, out_dir, {a.key for a in spec.axes if a.log},
-            summary.get("search", {}).get("best_point"))
+            summary.get("search", {}).get("best_point"),
+            spec.search["sense"] if spec.search else "max")
     write_json_atomic(out_dir / "sweep.json", summary)
     return summary
 
