@@ -200,6 +200,10 @@ def test_failing_points_recorded_and_sweep_goes_on(tmp_path, client):
     assert recs[2]["status"] == "error" and recs[2]["exit_code"] == 2
     assert "\n" not in recs[2]["error"] and recs[2]["outputs"][F1] is None
     assert res["status_counts"] == {"ok": 2, "timeout": 1, "error": 1}
+    # a re-run skips all four; --retry-failed runs the two failed ones again (and only them)
+    assert run_sweep(spec, tmp_path / "o", client=client)["ran"] == 0
+    again = run_sweep(spec, tmp_path / "o", client=client, retry_failed=True)
+    assert again["ran"] == 2 and again["skipped"] == 2 and again["n_ok"] == 2
 
 
 def test_output_no_point_produces_after_the_run(tmp_path, client):
