@@ -250,6 +250,23 @@ def test_search_finds_the_closed_form_optimum(tmp_path, client):
           f"force ratio {s['best_value'] / f_aligned:.6f} ({ratio_star:.6f})")
 
 
+@pytest.mark.parametrize("method", ["powell", "nelder-mead"])
+def test_scipy_search_finds_the_closed_form_optimum(tmp_path, client, method):
+    """The same optimum by a scipy optimiser over point runs: phi* = arccos(1/3) = 70.53 deg,
+    force 2/sqrt(3) x the aligned value."""
+    sw = write_sweep(tmp_path, f"[axes]\n{THROW} = {{start = 0.0, stop = 180.0, num = 7}}\n"
+                     f"[search]\nmaximize = '{F1}'\nmethod = '{method}'\nxtol = 1e-4\n"
+                     "max_points = 25\n")
+    res = run_sweep(sw, tmp_path / "o", client=client, figures=False)
+    s = res["search"]
+    f_aligned = res["output_ranges"][F1]["min"]
+    print(f"{method}: phi {s['best_parameters'][THROW]:.4f} deg, ratio "
+          f"{s['best_value'] / f_aligned:.8f}, {s['rounds'][-1]['evaluations']} evaluations")
+    assert s["best_parameters"][THROW] == pytest.approx(np.degrees(np.arccos(1 / 3)), abs=0.1)
+    assert s["best_value"] / f_aligned == pytest.approx(2 / np.sqrt(3), rel=1e-6)
+    assert s["rounds"][-1]["evaluations"] <= 30
+
+
 # ---------------------------------------------------------------- resumption after a kill
 
 

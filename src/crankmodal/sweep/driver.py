@@ -322,6 +322,8 @@ def _search(spec, client, tasks, store, done, out_dir, log, stats):
     top = best(current, s["objective"], s["sense"])
     rounds.append({"round": 0, "points": len(tasks), "best_point": top and top["point"],
                    "best_value": top and top["outputs"][s["objective"]]})
+    if s["method"] != "grid" and top is not None:
+        return _optimise(spec, client, store, done, out_dir, log, stats, top, rounds, n_next)
     for r in range(1, s["rounds"] + 1):
         if top is None:
             break
@@ -338,6 +340,37 @@ def _search(spec, client, tasks, store, done, out_dir, log, stats):
         if log:
             log(f"search round {r}: best {s['objective']} = {rounds[-1]['best_value']!r} at "
                 f"{top['parameters']}")
+    return rounds, keys
+
+
+def _optimise(spec, client, store, done, out_dir, log, stats, top, rounds, n_next):
+    """The scipy search from the coarse best point: each evaluation is one point run on the
+    cluster (one at a time: these optimisers are sequential)."""
+    from .search import objective_value, optimise
+
+    s = spec.search
+    keys: list[str] = []
+    count = {"n": n_next}
+
+    def evaluate(point):
+        task = plan_tasks(spec, [point], out_dir, count["n"], 1)[0]
+        if task["key"] not in done:
+            count["n"] += 1
+        _add(stats, run_tasks(client, [task], store, done, None))
+        keys.append(task["key"])
+        return objective_value(done[task["key"]], s["objective"])
+
+    calls = optimise(spec.axes, top["parameters"], evaluate, s["sense"], s["method"],
+                     s["max_points"], s["xtol"])
+    from .search import best
+
+    top = best([done[k] for k in keys] + [top], s["objective"], s["sense"])
+    rounds.append({"round": 1, "method": s["method"], "evaluations": calls,
+                   "points": len(set(keys)), "best_point": top["point"],
+                   "best_value": top["outputs"][s["objective"]]})
+    if log:
+        log(f"search ({s['method']}, {calls} evaluations): best {s['objective']} = "
+            f"{top['outputs'][s['objective']]!r} at {top['parameters']}")
     return rounds, keys
 
 

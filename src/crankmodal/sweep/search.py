@@ -75,3 +75,82 @@ def refine(axes: list[Axis], centre: dict, steps: dict[str, float], num: int):
         new_steps[a.key] = 2 * h / (num - 1)
     keys = [a.key for a in axes]
     return [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*values)], new_steps
+
+
+def to_unit(axis: Axis, value: float) -> float:
+    """A range axis's value as a coordinate in [0, 1] (log-scaled for a log axis)."""
+    if axis.log:
+        return (math.log(value) - math.log(axis.start)) / (math.log(axis.stop)
+                                                            - math.log(axis.start))
+    return (value - axis.start) / (axis.stop - axis.start)
+
+
+def from_unit(axis: Axis, u: float):
+    """The inverse of :func:`to_unit` (rounded on an integer axis)."""
+    u = min(max(float(u), 0.0), 1.0)
+    if axis.log:
+        v = math.exp(math.log(axis.start) + u * (math.log(axis.stop) - math.log(axis.start)))
+    else:
+        v = axis.start + u * (axis.stop - axis.start)
+    return round(v) if axis.integer else v
+
+
+def optimise(axes: list[Axis], start: dict, evaluate, sense: str, method: str,
+             max_points: int, xtol: float) -> int:
+    """A scipy optimiser from the coarse grid's best point, over the range axes.
+
+    Parameters
+    ----------
+    axes : list of Axis
+        List axes stay at ``start``'s values.
+    start : dict
+        The starting point (the coarse grid's best).
+    evaluate : callable
+        ``evaluate(point) -> float or None``: one point run (None: failed or not a number,
+        treated as the worst value).
+    sense : {"max", "min"}
+    method : {"powell", "nelder-mead"}
+        :func:`scipy.optimize.minimize` methods that need no gradient (a point is a whole run;
+        finite differences would double the runs and fail on the outputs' jumps).
+    max_points : int
+        Most runs the optimiser may ask for.
+    xtol : float
+        Tolerance on the axes scaled to [0, 1].
+
+    Returns
+    -------
+    int
+        Runs the optimiser asked for (repeated points are not run again by the caller).
+    """
+    from scipy.optimize import minimize
+
+    free = [a for a in axes if a.is_range and a.start != a.stop]
+    sign = -1.0 if sense == "max" else 1.0
+    calls = 0
+
+    def f(u):
+        nonlocal calls
+        calls += 1
+        point = {**start, **{a.key: from_unit(a, ui) for a, ui in zip(free, u, strict=True)}}
+        v = evaluate(point)
+        return 1e300 if v is None else sign * v
+
+    u0 = np.array([to_unit(a, start[a.key]) for a in free])
+    if method == "powell":
+        minimize(f, u0, method="Powell", bounds=[(0.0, 1.0)] * len(free),
+                 options={"maxfev": max_points, "xtol": xtol, "ftol": 1e-12})
+    else:
+        minimize(f, u0, method="Nelder-Mead", bounds=[(0.0, 1.0)] * len(free),
+                 options={"maxfev": max_points, "xatol": xtol, "fatol": 0.0,
+                          "initial_simplex": _simplex(u0, 0.1)})
+    return calls
+
+
+def _simplex(u0, size: float) -> np.ndarray:
+    """A starting simplex of ``size`` (in unit coordinates) around ``u0``, inside [0, 1]."""
+    pts = [u0]
+    for i in range(len(u0)):
+        p = u0.copy()
+        p[i] = p[i] + size if p[i] + size <= 1 else p[i] - size
+        pts.append(p)
+    return np.array(pts)

@@ -17,8 +17,11 @@
 
     [search]                            # optional: refine around the best point
     maximize = "mechanism.first_order_force_max_n"   # or minimize = "..."
+    method = "grid"                     # grid (rounds of num values) | powell | nelder-mead
     rounds = 3
     num = 5
+    max_points = 60                     # powell / nelder-mead: most runs
+    xtol = 1e-3                         # powell / nelder-mead: on the axes scaled to [0, 1]
 """
 
 from __future__ import annotations
@@ -34,7 +37,8 @@ from .axes import MODES, Axis, flatten_axes, generate, parse_axis
 
 KEYS = ("base", "mode", "samples", "seed", "set", "outputs", "timeout_s", "figures", "axes",
         "search", "name", "description")
-SEARCH_KEYS = ("maximize", "minimize", "rounds", "num")
+SEARCH_KEYS = ("maximize", "minimize", "method", "rounds", "num", "max_points", "xtol")
+SEARCH_METHODS = ("grid", "powell", "nelder-mead")
 
 
 @dataclass
@@ -109,12 +113,23 @@ def parse_search(table, axes: list[Axis], mode: str) -> dict:
     num = _typed("search.num", table.get("num", 5), (int,), "an integer >= 3")
     if rounds < 0 or num < 3:
         raise SceneError(f"search: rounds must be >= 0 and num >= 3, got {rounds}, {num}")
+    method = _typed("search.method", table.get("method", "grid"), (str,),
+                    f"one of {', '.join(SEARCH_METHODS)}")
+    if method not in SEARCH_METHODS:
+        raise SceneError(f"search.method: {method!r}; allowed: {', '.join(SEARCH_METHODS)}")
+    max_points = _typed("search.max_points", table.get("max_points", 60), (int,),
+                        "an integer >= 1")
+    xtol = _typed("search.xtol", table.get("xtol", 1e-3), (int, float), "a number in (0, 1)")
+    if max_points < 1 or not 0 < xtol < 1:
+        raise SceneError(f"search: max_points must be >= 1 and 0 < xtol < 1, got {max_points}, "
+                         f"{xtol}")
     if mode != "grid":
         raise SceneError(f"search: refinement starts from a grid; mode is {mode!r}, use 'grid'")
     if not any(a.is_range for a in axes):
         raise SceneError("search: needs at least one range axis {start, stop, num} to refine")
     return {"objective": objective, "sense": "max" if goals[0] == "maximize" else "min",
-            "rounds": rounds, "num": num}
+            "rounds": rounds, "num": num, "method": method, "max_points": max_points,
+            "xtol": float(xtol)}
 
 
 def parse_sweep(data: dict, base_dir: Path | str = ".", name: str = "sweep") -> SweepSpec:
