@@ -109,6 +109,16 @@ def test_output_of_a_missing_section_refused(tmp_path):
         run_sweep(sw, tmp_path / "o")
 
 
+def test_second_sweep_into_a_busy_folder_refused(tmp_path):
+    from crankmodal.sweep.store import folder_lock
+
+    sw = write_sweep(tmp_path, "[axes]\nmechanism.speed_rpm = [1000]\n")
+    (tmp_path / "o").mkdir()
+    with folder_lock(tmp_path / "o"), pytest.raises(CrankmodalError, match="another sweep"):
+        run_sweep(sw, tmp_path / "o", scheduler="tcp://127.0.0.1:1")
+    assert not (tmp_path / "o" / "records.jsonl").exists()
+
+
 def test_unreachable_scheduler_is_exit_2_one_line(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr("crankmodal.sweep.driver.CONNECT_TIMEOUT_S", 1)
     sw = write_sweep(tmp_path, "[axes]\nmechanism.speed_rpm = [1000]\n")

@@ -19,7 +19,7 @@ from ..errors import CrankmodalError
 from ..results import make_out_dir, write_json_atomic
 from .execute import build_scene, execute_point, overrides_of, point_key
 from .spec import SweepSpec, load_sweep
-from .store import RecordStore
+from .store import RecordStore, folder_lock
 from .table import missing_outputs, refresh_outputs, suggestion, summarise, write_csv
 
 #: The workers' environment: one BLAS/OpenMP thread per worker process.
@@ -241,6 +241,14 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
     tasks = plan_tasks(spec, spec.points(), out_dir.resolve())  # every point checked first
     check_output_sections(spec, tasks[0])
     out_dir = make_out_dir(out_dir)
+    with folder_lock(out_dir):
+        return _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed,
+                           figures, log, t0)
+
+
+def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, figures, log,
+                t0) -> dict:
+    """:func:`run_sweep` once the folder is made and locked."""
     for stale in ("sweep.json", "sweep.csv", *(p.name for p in out_dir.glob("sweep_*.png"))):
         # a failed re-run must not leave an old table or map looking like its answer
         (out_dir / stale).unlink(missing_ok=True)

@@ -7,11 +7,13 @@ points that were in flight. Reading keeps the last record of each key.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 from pathlib import Path
 
+from ..errors import OutputError
 from ..results import output_error
 
 
@@ -72,3 +74,31 @@ class RecordStore:
                 fh.seek(-1, os.SEEK_END)
                 if fh.read(1) != b"\n":
                     fh.write(b"\n")
+
+
+@contextlib.contextmanager
+def folder_lock(folder: Path):
+    """Hold ``folder/.sweep.lock`` (``flock``) for a sweep's run: a second sweep into the same
+    folder would interleave its records and race on the tables, so it is refused by name."""
+    import fcntl
+
+    path = Path(folder) / ".sweep.lock"
+    try:
+        fh = open(path, "a+")  # noqa: SIM115 (held for the lock's lifetime, closed below)
+    except OSError as exc:
+        raise output_error(exc, path) from None
+    try:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            fh.seek(0)
+            owner = fh.read().strip() or "?"
+            raise OutputError(f"{folder}: another sweep is running into this folder (pid "
+                              f"{owner}); wait for it or give another --out") from None
+        fh.seek(0)
+        fh.truncate()
+        fh.write(str(os.getpid()))
+        fh.flush()
+        yield
+    finally:
+        fh.close()  # releases the lock
