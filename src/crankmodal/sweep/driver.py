@@ -127,9 +127,13 @@ class LazyClient:
             self.info = {"scheduler": c.scheduler.address, "workers": len(c.nthreads()),
                          "threads": sum(c.nthreads().values()), "dashboard": _dashboard(c)}
             if self.log:
-                self.log(f"dask: {self.info['workers']} workers at {self.info['scheduler']}"
-                         + (f", dashboard {self.info['dashboard']}"
-                            if self.info["dashboard"] else ""))
+                _, scheduler, workers, _ = self.args
+                if scheduler and workers:
+                    self.log(f"--workers {workers} ignored: the cluster at {scheduler} has its own")
+                board = self.info["dashboard"]
+                self.log(f"dask: {self.info['workers']} workers at {self.info['scheduler']}, "
+                         + (f"dashboard {board}" if board else
+                            "no dashboard (it needs bokeh: pip install 'bokeh>=3.1')"))
         return self.client
 
 
