@@ -165,6 +165,17 @@ def test_small_sweep_on_two_workers(tmp_path, client):
     assert again["dask"] == {}
 
 
+def test_cli_on_a_cluster_by_address(tmp_path, client, capsys):
+    """--scheduler: the same sweep on an existing cluster (here the module's, by its address)."""
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n[axes]\nmechanism.speed_rpm = [900, 1100]\n")
+    addr = client.scheduler.address
+    assert main(["--quiet", "sweep", str(sw), "--out", str(tmp_path / "o"), "--scheduler", addr,
+                 "--no-figures"]) == 0
+    out = capsys.readouterr()
+    assert f"dask: 2 workers at {addr}" in out.err and "2 points, 2 ok" in out.out
+    assert json.loads((tmp_path / "o" / "sweep.json").read_text())["dask"]["scheduler"] == addr
+
+
 def test_relative_out_folder(tmp_path, client, monkeypatch):
     monkeypatch.chdir(tmp_path)
     sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n[axes]\nmechanism.speed_rpm = [1000]\n")
