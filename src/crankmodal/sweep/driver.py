@@ -191,7 +191,9 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
                 pb.update(1)
                 pb.set_postfix(failed=failed, refresh=False)
                 if log and rec["status"] != "ok":
+                    pb.clear()  # the line above the bar, not through it
                     log(f"point {rec['point']}: {rec['status']}: {rec['error']}")
+                    pb.refresh()
                 nxt = next(it, None)
                 if nxt is not None:
                     submit(nxt)

@@ -153,7 +153,7 @@ def _run_in_child(args, timeout_s: float) -> dict:
         _, status = os.waitpid(pid, 0)
     if timed_out:
         return {"status": "timeout", "exit_code": None, "outputs": dict.fromkeys(args[4]),
-                "error": f"timeout: the point ran past timeout_s = {timeout_s:g} s"}
+                "error": f"the point ran past timeout_s = {timeout_s:g} s"}
     try:
         return pickle.loads(b"".join(chunks))
     except Exception:  # noqa: BLE001 (no complete record came back)
