@@ -12,13 +12,14 @@ from crankmodal.dynamics.system import Multibody
 MU, R, L, C = 0.0175, 0.02, 0.042, 2.1e-5   # seed 001 Table 2
 
 
-def _reynolds_force(eps, eps_dot, gamma_dot, omega, n=400_001):
-    """Short-bearing pressure integrated over the pi film (pi < theta < 2 pi), midpoint rule."""
-    th = np.pi + (np.arange(n) + 0.5) * np.pi / n
+def _reynolds_force(eps, eps_dot, gamma_dot, omega, n=800_001):
+    """Short-bearing pressure integrated where it is positive (pi film), midpoint rule."""
+    th = (np.arange(n) + 0.5) * 2 * np.pi / n
     h = C * (1.0 - eps * np.cos(th))
     G = 6 * MU * C * (eps * (omega - 2 * gamma_dot) * np.sin(th) - 2 * eps_dot * np.cos(th))
+    G = np.minimum(G, 0.0)                       # p >= 0 where G <= 0; the rest cavitates
     # p = G (z^2 - L^2/4) / (2 h^3);  int (z^2 - L^2/4) dz = -L^3/6;  F = -int p u R dtheta dz
-    w = R * L**3 / 12 * G / h**3 * np.pi / n
+    w = R * L**3 / 12 * G / h**3 * 2 * np.pi / n
     return np.sum(w * np.cos(th)), np.sum(w * np.sin(th))
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import contact
-from .lubrication import short_bearing_force
+from .lubrication import short_bearing_film
 
 FILM_MODELS = ("short", "finite")
 
@@ -138,12 +138,16 @@ class ClearanceJoint:
         d = k["d"]
         eps = min(d / c, self.eps_max)
         n, t = k["n"], k["t"]
-        gamma_dot = float(t @ k["vrel"]) / d if d > 1e-12 * c else 0.0
+        # wedge eps (omega - 2 gamma_dot) with eps gamma_dot = (t . vrel) / c: no 1/|e|, so the
+        # force stays smooth through the bearing centre (gamma_dot alone is singular there);
+        # beyond eps_max the film is frozen at eps_max, as is its whirl term
+        whirl = float(t @ k["vrel"]) / c * (eps * c / d if d > self.eps_max * c else 1.0)
+        wedge = eps * k["omega_sum"] - 2.0 * whirl
         if self.film_model == "finite":
-            from .reynolds import finite_bearing_force as law
+            from .reynolds import finite_bearing_film as law
         else:
-            law = short_bearing_force
-        fr, ftan = law(eps, float(n @ k["vrel"]) / c, gamma_dot, k["omega_sum"], self.viscosity,
+            law = short_bearing_film
+        fr, ftan = law(eps, wedge, float(n @ k["vrel"]) / c, self.viscosity,
                        self.journal_radius, self.bearing_length, c)
         return float(fr) * n + float(ftan) * t
 

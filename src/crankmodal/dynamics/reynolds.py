@@ -266,10 +266,21 @@ def finite_bearing_force(eps, eps_dot, gamma_dot, omega, viscosity, radius, leng
     clipped to the table, [0.005, 0.96].
     """
     e = float(min(max(eps, EPS_TABLE[0]), EPS_TABLE[-1]))
+    wedge = e * (float(omega) - 2.0 * float(gamma_dot))
+    return finite_bearing_film(eps, wedge, eps_dot, viscosity, radius, length, clearance)
+
+
+def finite_bearing_film(eps, wedge, eps_dot, viscosity, radius, length, clearance):
+    """Finite-bearing film force from the wedge ``eps (omega - 2 gamma_dot)`` (1/s), N.
+
+    As :func:`finite_bearing_force`, with the arguments of
+    :func:`.lubrication.short_bearing_film` (the wedge stays finite at the bearing centre).
+    """
+    e = float(min(max(eps, EPS_TABLE[0]), EPS_TABLE[-1]))
     f_r, f_t = film_table(round(float(length) / (2.0 * radius), 6))
     s = 1.0 - e * e
-    w = float(omega) - 2.0 * float(gamma_dot)
-    r = abs(w) * e / s**2
+    w = float(wedge)
+    r = abs(w) / s**2
     q = float(eps_dot) / s**2.5
     mag = np.hypot(r, q)
     if mag == 0.0:
