@@ -292,7 +292,8 @@ def test_scipy_search_finds_the_closed_form_optimum(tmp_path, client, method):
 
 
 def test_resume_after_kill_runs_only_the_missing_points(tmp_path, client):
-    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n"
+    # n_points = 5000: ~0.13 s a point, so the kill lands well before the last of the 12
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\nset = ['mechanism.n_points=5000']\n"
                      "[axes]\nmechanism.speed_rpm = {start = 900, stop = 2000, num = 12}\n")
     out = tmp_path / "o"
     env = {**os.environ, "CRANKMODAL_QUIET": "1"}
