@@ -206,8 +206,11 @@ def test_run_never_imports_dask(tmp_path):
 
 
 def test_failing_points_recorded_and_sweep_goes_on(tmp_path, client):
-    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\ntimeout_s = 1.5\n"
-                     "[axes]\nmechanism.n_points = [360, 100000, 720, 1440]\n")
+    # point 1 (100 000 samples, 24 Fourier orders) takes 5-14 s: far past the 1.5 s limit
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\ntimeout_s = 1.5\nmode = 'zip'\n[axes]\n"
+                     "mechanism.n_points = [360, 100000, 720, 1440]\n"
+                     "mechanism.harmonics = ['series', 'fourier', 'series', 'series']\n"
+                     "mechanism.max_order = [2, 24, 2, 2]\n")
     spec = load_sweep(sw)
     tasks = plan_tasks(spec, spec.points(), (tmp_path / "o").resolve())
     # point 2's output folder is a file: an OutputError (exit 2) inside the run
