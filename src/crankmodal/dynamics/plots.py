@@ -123,15 +123,37 @@ def plot_energy(hist, path: Path) -> Path:
 
 
 def plot_study(study, path: Path) -> Path:
-    """Error of the key outputs against wall time over the tolerance sequence."""
+    """Error against wall time over the tolerance sequence: the single-trajectory peaks (left)
+    and the per-revolution statistics with their standard errors (right; filled markers:
+    converged, i.e. within two combined standard errors or 1 % of the tightest rtol)."""
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    stats = study.get("statistics") or {}
+    fig, axs = plt.subplots(1, 2 if stats else 1, figsize=(13 if stats else 7, 4.5),
+                            squeeze=False)
+    ax = axs[0, 0]
     w = np.asarray(study["wall_time_s"])
     for k in ("d_peak_contact_force", "d_peak_piston_acceleration", "d_main_bearing_order_rms"):
         ax.loglog(w[:-1], np.maximum(np.asarray(study[k])[:-1], 1e-12), "o-", label=k[2:])
     for x, y, r in zip(w[:-1], np.asarray(study["d_peak_piston_acceleration"])[:-1],
                        study["rtol"][:-1]):
         ax.annotate(f"rtol {r:g}", (x, max(y, 1e-12)), fontsize=7)
-    ax.set(xlabel="wall time [s]", ylabel="relative change vs tightest rtol")
+    ax.set(xlabel="wall time [s]", ylabel="relative change vs tightest rtol",
+           title="single-trajectory peaks")
     ax.legend(fontsize=8)
+    if stats:
+        ax = axs[0, 1]
+        for name, c in stats.items():
+            # a change of exactly zero (e.g. no impacts either way) has no place on a log axis
+            d = np.array([np.nan if not v else v for v in c["rel_change"][:-1]])
+            ok = np.asarray(c["converged"][:-1], bool)
+            (line,) = ax.loglog(w[:-1], d, "-", lw=0.8, label=name)
+            ax.loglog(w[:-1][ok], d[ok], "o", color=line.get_color(), ms=4)
+            ax.loglog(w[:-1][~ok], d[~ok], "o", mfc="none", color=line.get_color(), ms=4)
+        ax.axhline(0.01, color="k", ls=":", lw=0.8)
+        for x, r in zip(w[:-1], study["rtol"][:-1]):
+            ax.annotate(f"rtol {r:g}", (x, 0.02), xycoords=ax.get_xaxis_transform(), fontsize=7,
+                        rotation=90, va="bottom")
+        ax.set(xlabel="wall time [s]", ylabel="relative change vs tightest rtol",
+               title="per-revolution statistics (filled: converged)")
+        ax.legend(fontsize=5, ncol=2)
     return _save(plt, fig, path)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 BAND_EDGES_HZ = (0.0, 100.0, 300.0, 1000.0, 3000.0, np.inf)
+REL_TOL = 0.01  # a change under 1 % is converged whatever the standard error says
 ORDERS = (1, 2, 3, 4)
 _BOOTSTRAP = 200
 
@@ -285,20 +286,28 @@ def _fmt(value: float, sem: float, unit: str) -> str:
     return f"{value / k:.4g} ± {sem / k:.2g} {'k' if k > 1 else ''}{unit}"
 
 
-def converged_summary(stats: dict, study: dict | None = None) -> str:
+def converged_summary(stats: dict, study: dict | None = None, rtol: float | None = None) -> str:
     """The headline numbers of a clearance run for the summary line: per-revolution means with
-    their standard errors and, with a tolerance ``study``, whether each converged (change
-    against the tightest rtol, at the second tightest) and how many statistics did."""
+    their standard errors and, with a tolerance ``study``, whether each converged (its change
+    against the tightest rtol, at the run's own ``rtol`` if the study has it, else at the
+    second tightest) and how many statistics did."""
     n = stats["window"]["n_revolutions"]
     conv = (study or {}).get("statistics", {})
+    at = -2
+    if conv and rtol is not None:
+        hit = [i for i, r in enumerate(study["rtol"][:-1]) if np.isclose(r, rtol, rtol=1e-9)]
+        at = hit[0] if hit else -2
 
     def tag(name):
         c = conv.get(name)
         if not c or len(c["converged"]) < 2:
             return ""
-        d = c["rel_change"][-2]
-        word = "converged" if c["converged"][-2] else "NOT converged"
-        return f" ({word}, {100 * d:.2g} %)" if d is not None else " (NOT converged)"
+        d = c["rel_change"][at]
+        if d is None or not c["converged"][at]:
+            return " (NOT converged" + ("" if d is None else f": {100 * d:.2g} %") + ")"
+        if d <= REL_TOL:
+            return f" (converged: {100 * d:.2g} %)"
+        return f" (converged within its standard error: {100 * d:.2g} %)"
 
     mb = stats["main_bearing_force"]["per_rev_peak"]
     parts = [f"main-bearing per-rev peak {_fmt(mb['mean'], mb['sem'], 'N')}"
@@ -318,8 +327,9 @@ def converged_summary(stats: dict, study: dict | None = None) -> str:
         parts.append(text)
     out = ", ".join(parts) + f" (mean ± standard error over {n} revs)"
     if conv and len(study["rtol"]) >= 2:
-        ok = [k for k, c in conv.items() if c["converged"][-2]]
+        ok = [k for k, c in conv.items() if c["converged"][at]]
+        tight = [k for k in ok if (conv[k]["rel_change"][at] or 0.0) <= REL_TOL]
         out += (f"; {len(ok)}/{len(conv)} per-rev statistics converged at rtol "
-                f"{study['rtol'][-2]:g} (against {study['rtol'][-1]:g}: within 2 standard errors "
-                f"or 1 %)")
+                f"{study['rtol'][at]:g} against {study['rtol'][-1]:g} ({len(tight)} to 1 %, "
+                f"{len(ok) - len(tight)} only within 2 standard errors)")
     return out
