@@ -108,6 +108,40 @@ def _geometric_regions(points, cells, specs: list) -> dict:
     return out
 
 
+def check_cells_and_points(name: str, cells: np.ndarray, points) -> None:
+    """Refuse volume cells that name missing points, and non-finite points the cells use.
+
+    A NaN or infinite coordinate otherwise reaches the FE assembly and the eigensolver (a
+    ``LinAlgError`` traceback, or a misleading "inverted elements").
+
+    Raises
+    ------
+    InputFileError
+        Naming the file, the first offending cell or point (0-based, as in the file) and value.
+    """
+    points = np.asarray(points)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise InputFileError(f"geometry.file: {name} is not a 3D mesh (points of shape "
+                             f"{points.shape})")
+    bad = np.flatnonzero(np.any((cells < 0) | (cells >= len(points)), axis=1))
+    if len(bad):
+        c = cells[bad[0]]
+        raise InputFileError(f"geometry.file: {name}: volume cell {bad[0]} refers to point "
+                             f"{int(c[(c < 0) | (c >= len(points))][0])}, but the file has "
+                             f"{len(points)} points (0 to {len(points) - 1})")
+    if not np.issubdtype(points.dtype, np.number):
+        raise InputFileError(f"geometry.file: {name}: point coordinates are not numbers "
+                             f"({points.dtype})")
+    used = np.unique(cells)
+    finite = np.all(np.isfinite(points[used].astype(float)), axis=1)
+    if not np.all(finite):
+        i = int(used[np.argmin(finite)])
+        raise InputFileError(f"geometry.file: {name}: point {i} has a non-finite coordinate "
+                             f"{np.array2string(points[i].astype(float), separator=', ')} "
+                             f"({int((~finite).sum())} such points); every coordinate must be a "
+                             f"finite number (m)")
+
+
 def import_mesh(path, specs: list = ()) -> Part:
     """A part from a meshio-readable volume mesh (metres assumed) with its named groups.
 
@@ -130,12 +164,11 @@ def import_mesh(path, specs: list = ()) -> Part:
                              f"found {sorted({b.type for b in m.cells})}")
     kind = kinds.pop()
     cells = np.concatenate([b.data for _, b in vol]).astype(np.int64)
+    check_cells_and_points(path.name, cells, m.points)
     used = np.unique(cells)
     remap = -np.ones(len(m.points), dtype=np.int64)
     remap[used] = np.arange(len(used))
     points = np.asarray(m.points, float)[used]
-    if points.shape[1] != 3:
-        raise InputFileError(f"geometry.file: {path.name} is not a 3D mesh")
     cells = remap[cells]
 
     named = {}
