@@ -184,6 +184,11 @@ def reduction(points: np.ndarray, used: np.ndarray, supports: list[Support]) -> 
     """Sparse ``T`` (3 n_points × n_free) with ``u = T q`` satisfying every support.
 
     Points no element uses are left out as well (they have no stiffness or mass).
+
+    Raises
+    ------
+    SceneError
+        The supports leave no degree of freedom free (naming them).
     """
     n = len(points)
     fixed = np.zeros((n, 3), bool)
@@ -223,6 +228,12 @@ def reduction(points: np.ndarray, used: np.ndarray, supports: list[Support]) -> 
             cols.append(np.full(3, ncol))
             vals.append(b)
             ncol += 1
+    if ncol == 0 and supports:  # else the caller would ask for a finer mesh, which fixes nothing
+        who = " and ".join(s.label for s in supports)
+        held = "hold" if len(supports) > 1 else "holds"
+        raise SceneError(f"{who}: {held} every node the elements use in every direction, so "
+                         f"nothing is left free; support a part of the mesh only (a smaller "
+                         f"box or a region) or fix fewer components")
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(3 * n, ncol))
 
