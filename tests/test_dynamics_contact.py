@@ -207,3 +207,116 @@ def test_the_deepest_point_of_an_impact_is_an_event_however_coarse_the_output():
         assert abs(k["delta_dot"]) < 1e-6 * v0
         assert contact.normal_force("hertz", k["delta"], k["delta_dot"], joint.law_params,
                                     v0) == pytest.approx(K * d_max**1.5, rel=2e-6)
+
+
+# ----------------------------------------------------------------- Johnson's conformal cylinders
+E_STAR = 2.1e11 / (2 * (1 - 0.3**2))  # steel on steel, plane strain, Pa
+
+
+def _johnson_delta(F, L, dR):
+    """Johnson's closed form, written out: delta = F/(pi L E*) (ln(4 pi L E* dR / F) - 1)."""
+    import math
+
+    return F / (math.pi * L * E_STAR) * (math.log(4 * math.pi * L * E_STAR * dR / F) - 1.0)
+
+
+@pytest.mark.parametrize("F", [1.0, 100.0, 1e4, 2e5])
+def test_johnson_cylinder_force_inverts_the_closed_form_approach(F):
+    # a 45 mm journal, 45 mm long, 0.1 mm clearance: 20 kN -> 5.9 um (the four-star's big end
+    # penetrated 111 um under its IMPACT stiffness)
+    L, dR = 0.045, 1e-4
+    K = np.pi * L * E_STAR
+    d = _johnson_delta(F, L, dR)
+    assert float(contact.johnson_cylinder_approach(F, K, dR)) == pytest.approx(d, rel=1e-14)
+    assert float(contact.johnson_cylinder_force(d, K, dR)) == pytest.approx(F, rel=1e-12)
+    assert float(contact.normal_force("johnson_cylinder", d, 0.0, {
+        "stiffness": K, "radial_clearance": dR, "restitution": 0.9})) == pytest.approx(F, rel=1e-12)
+    if F == 1e4:
+        assert d == pytest.approx(3.36e-6, rel=1e-3)  # micrometres; within the range (< 0.4 dR)
+
+
+def test_johnson_cylinder_energy_and_stiffness_are_the_integral_and_slope_of_its_force():
+    from scipy.integrate import quad
+
+    K, dR = np.pi * 0.02 * E_STAR, 5e-5
+    for d in (1e-8, 1e-6, 1.5e-5, 3e-5):  # the last beyond the tangent continuation (0.40 dR)
+        w = quad(lambda x: float(contact.johnson_cylinder_force(x, K, dR)), 0.0, d,
+                 epsabs=0.0, epsrel=1e-11, limit=200)[0]
+        assert float(contact.johnson_cylinder_energy(d, K, dR)) == pytest.approx(w, rel=1e-8)
+        h = d * 1e-6
+        slope = (contact.johnson_cylinder_force(d + h, K, dR)
+                 - contact.johnson_cylinder_force(d - h, K, dR)) / (2 * h)
+        assert float(contact.johnson_cylinder_stiffness(d, K, dR)) == pytest.approx(slope, rel=1e-5)
+    assert contact.johnson_cylinder_force(-1e-6, K, dR) == 0.0
+
+
+@pytest.mark.parametrize("e", [0.3, 0.9])
+def test_johnson_cylinder_rebound_matches_the_exact_energy_integral(e):
+    # F = F_J(delta) (1 + chi delta'): the phase-plane integral gives the Hunt-Crossley restitution
+    # for any elastic force, so the same oracle holds for Johnson's law with LN damping
+    v0 = 1.0
+    a = float(contact.hysteresis_factor("johnson_cylinder", e, v0)) * v0
+    expected = _hunt_crossley_exact_restitution(a)
+    params = {"stiffness": np.pi * 0.02 * E_STAR, "radial_clearance": CLEARANCE, "restitution": e}
+    onsets, _ = _first_two_impacts("johnson_cylinder", params, v0)
+    assert len(onsets) >= 2
+    assert onsets[1][1] / v0 == pytest.approx(expected, rel=2e-5)
+
+
+def test_johnson_cylinder_slider_crank_penetrates_micrometres_and_soft_impact_is_warned(tmp_path):
+    # End to end: a 3 kN gas load on a 40 mm journal, 20 mm long, in a 0.1 mm clearance. Johnson's
+    # law: micrometres and no warning. IMPACT at K = 1e9 (issue 18: 0.32 mm in the four-star):
+    # a penetration warning naming the joint, the clearance and contact.stiffness.
+    import copy
+    import warnings as w
+
+    from crankmodal.runner import run
+    from crankmodal.scene import scene_from_dict
+
+    base = {"dynamics": {
+        "mechanism": "slider_crank", "speed_rpm": 3000.0, "end_time": 0.025, "run_ideal": False,
+        "gas_force_deg": [0.0, 90.0, 180.0, 270.0, 360.0],
+        "gas_force_n": [3000.0, 500.0, 0.0, 500.0, 3000.0],
+        "crank_train": {"crank_radius": 0.035, "rod_length": 0.14},
+        "clearances": [{"joint": "big_end_1", "clearance": 1e-4, "journal_radius": 0.02,
+                        "bearing_length": 0.02}],
+        "contact": {"law": "johnson_cylinder", "restitution": 0.8}}}
+    with w.catch_warnings():
+        w.simplefilter("ignore")
+        res = run(scene_from_dict(copy.deepcopy(base), name="j"), tmp_path / "j",
+                  figures=False)["dynamics"]
+    j = res["clearance_joints"]["big_end_1"]
+    assert j["law"] == "johnson_cylinder" and j["stiffness"] == pytest.approx(np.pi * 0.02 * E_STAR)
+    # while in contact: median 3.2 um under a median 4.1 kN (the closed form's 3.16 um)
+    arr = np.load(tmp_path / "j" / "dynamics.npz")
+    pen, fn = arr["contact_big_end_1_penetration"], arr["contact_big_end_1_fn"]
+    on = pen > 0.0
+    assert 1e-6 < np.median(pen[on]) < 5e-6
+    assert np.median(pen[on]) == pytest.approx(_johnson_delta(np.median(fn[on]), 0.02, 1e-4),
+                                               rel=0.05)
+    # the deepest point (the first impact, 0.7 m/s from the centred start) on the closed form
+    F = j["peak_contact_force_n"]
+    assert j["max_penetration_m"] == pytest.approx(_johnson_delta(F, 0.02, 1e-4), rel=0.3)
+    assert not any("penetrates" in t for t in res["warnings"])
+    soft = copy.deepcopy(base)
+    soft["dynamics"]["contact"] = {"law": "impact", "stiffness": 1e9}
+    with w.catch_warnings():
+        w.simplefilter("ignore")
+        res = run(scene_from_dict(soft, name="s"), tmp_path / "s", figures=False)["dynamics"]
+    texts = [t for t in res["warnings"] if "penetrates" in t]
+    assert len(texts) == 1
+    assert "'big_end_1'" in texts[0] and "0.0001 m clearance" in texts[0]
+    assert "dynamics.contact.stiffness (now 1e+09)" in texts[0] and "johnson_cylinder" in texts[0]
+
+
+def test_johnson_cylinder_needs_the_bearing_length():
+    from crankmodal.errors import SceneError
+    from crankmodal.runner import check
+    from crankmodal.scene import scene_from_dict
+
+    data = {"dynamics": {"mechanism": "slider_crank", "speed_rpm": 3000.0,
+                         "clearances": [{"joint": "big_end_1"}],
+                         "contact": {"law": "johnson_cylinder"}}}
+    with pytest.raises(SceneError, match=r"dynamics.clearances\[0\].bearing_length: is required "
+                                         "with contact.law = 'johnson_cylinder'"):
+        check(scene_from_dict(data, name="t"))

@@ -129,7 +129,11 @@ def test_impact_peaks_do_not_depend_on_the_output_step(tmp_path):
             warnings.simplefilter("always")
             res = run(_scene(data), tmp_path / str(step), figures=False)["dynamics"]
         arrays = np.load(tmp_path / str(step) / "dynamics.npz")
-        out[step] = (res, arrays, [w for w in caught if w.category is ModelWarning])
+        # the short-contact warning (K = 1e11, a third of steel's, also penetrates 34 % of the
+        # clearance: the validity warning of test_dynamics_contact.py, left aside here)
+        res["warnings"] = [t for t in res["warnings"] if "penetrates" not in t]
+        out[step] = (res, arrays, [w for w in caught if w.category is ModelWarning
+                                   and "penetrates" not in str(w.message)])
     (fine, fine_arr, fine_warn), (coarse, coarse_arr, coarse_warn) = out[None], out[1e-3]
     jf, jc = fine["clearance_joints"]["big_end_1"], coarse["clearance_joints"]["big_end_1"]
     assert jf["impact_count"] > 3

@@ -30,7 +30,14 @@ def contact_arguments(p) -> tuple[dict, dict]:
                 "wear_angle": float(np.deg2rad(cl["wear_angle_deg"])),
                 "viscosity": cl["viscosity"], "bearing_length": cl["bearing_length"] or 0.0,
                 "film_model": cl["film_model"]}
-        if c["stiffness"] is None:
+        if c["law"] == "johnson_cylinder":  # a line contact: its own stiffness pi L E*, and dR
+            K = c["stiffness"]
+            if K is None:
+                K = np.pi * cl["bearing_length"] * contact.effective_modulus(c["E"], c["nu"],
+                                                                             c["E"], c["nu"])
+            spec["contact"] = {"law_params": dict(law_params, stiffness=float(K),
+                                                  radial_clearance=cl["clearance"])}
+        elif c["stiffness"] is None:
             rj = cl["journal_radius"]
             K = contact.cylinder_stiffness(rj, rj + cl["clearance"], c["E"], c["nu"], c["E"], c["nu"])
             spec["contact"] = {"law_params": dict(law_params, stiffness=float(K))}

@@ -107,8 +107,11 @@ CLEARANCE = {
 }
 
 CONTACT = {
-    "law": Field("str", "impact", "normal force law", choices=contact.NORMAL_LAWS),
-    "stiffness": Field("float", None, "N/m^exponent (default: from E, nu and the radii)", gt=0.0),
+    "law": Field("str", "impact", "normal force law (johnson_cylinder: conformal cylinders, "
+                 "needs each clearance's bearing_length)", choices=contact.NORMAL_LAWS),
+    "stiffness": Field("float", None, "N/m^exponent (default: from E, nu and the radii); "
+                       "johnson_cylinder: pi L E* in N/m (default: from E, nu and bearing_length)",
+                       gt=0.0),
     "exponent": Field("float", 1.5, "force exponent", gt=0.0, le=3.0),
     "damping": Field("float", 300.0, "N s/m (impact: full damping; kelvin_voigt, power_damped)", ge=0.0),
     "penetration": Field("float", 1e-4, "impact: penetration of full damping, m", gt=0.0),
@@ -211,6 +214,9 @@ def _cross_checks(p):
         if c["viscosity"] is not None and c["clearance_major"] is not None:
             raise SceneError(f"dynamics.clearances[{i}].viscosity: the film model needs a round "
                              "bore; remove clearance_major or viscosity")
+        if p["contact"]["law"] == "johnson_cylinder" and c["bearing_length"] is None:
+            raise SceneError(f"dynamics.clearances[{i}].bearing_length: is required with "
+                             "contact.law = 'johnson_cylinder' (bearing length, m, > 0)")
         if c["joint"] in seen:
             raise SceneError(f"dynamics.clearances[{i}].joint: {c['joint']!r} given twice")
         seen.add(c["joint"])
