@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import NumericalError
+from ..progress import bar
 from .system import N_AUX, BudgetExceeded, NonFinite
 
 
@@ -40,6 +41,10 @@ class SolverSettings:
         Largest step, s.
     max_rhs_evals : int
         Budget of right-hand-side evaluations; beyond it the run stops with a NumericalError.
+    time_scales : tuple of TimeScale
+        The clearance joints' contact time scales (:mod:`.timescales`), if estimated: the advice
+        of a failed run then names the key that limits the step (``contact.damping`` or
+        ``contact.stiffness``).
     """
 
     method: str = "RK45"
@@ -48,6 +53,7 @@ class SolverSettings:
     velocity_scale: float = 1000.0
     max_step: float | None = None
     max_rhs_evals: int = 2_000_000
+    time_scales: tuple = ()
 
 
 @dataclass
@@ -95,15 +101,47 @@ def _events(sysm, in_contact, memory):
     return evs, tags
 
 
-def _stiffness_advice(sysm) -> str:
+#: what to try instead of each method on a stiff run (never the method in use)
+_OTHER_METHODS = {"RK45": "'LSODA' or 'Radau'", "DOP853": "'LSODA' or 'Radau'",
+                  "LSODA": "'Radau'", "Radau": "'LSODA' or 'BDF'", "BDF": "'Radau'"}
+
+
+def _stiffness_advice(sysm, settings: SolverSettings | None = None) -> str:
+    """What to change after a failed or over-budget run: the key that limits the step (from
+    ``settings.time_scales``; the stiffness when not estimated) and a method other than the
+    one in use."""
     if not sysm.clearances:
         return "tighten nothing: ideal joints only; check the speed and masses"
+    method = settings.method if settings is not None else "RK45"
+    other = _OTHER_METHODS.get(method, "'Radau'")
+    if settings is not None and settings.time_scales:
+        from .timescales import responsible
+
+        ts = responsible(settings.time_scales)
+        return (f"joint {ts.joint!r} limits the step to {ts.step:.2g} s through "
+                f"{ts.describe()}: lower {ts.key}, use solver.method = {other}, or raise "
+                f"solver.max_rhs_evals")
     cj = sysm.clearances[0]
     K = cj.law_params.get("stiffness", float("nan"))
     return (f"the contact of joint {cj.name!r} is the stiff part (contact.stiffness = {K:.3g}, "
             f"clearance = {cj.clearance:.3g} m) or its friction near stiction: lower "
-            f"contact.stiffness, use solver.method = 'LSODA' or 'Radau', or raise "
-            f"solver.max_rhs_evals")
+            f"contact.stiffness, use solver.method = {other}, or raise solver.max_rhs_evals")
+
+
+def _progress_rhs(rhs, pbar):
+    """``rhs`` that advances ``pbar`` to the simulated time reached, at most every 0.1 s of
+    wall time (one clock read per evaluation)."""
+    state = {"next": 0.0}
+
+    def fun(t, y):
+        now = time.perf_counter()
+        if now >= state["next"]:
+            state["next"] = now + 0.1
+            if t > pbar.n:
+                pbar.update(t - pbar.n)
+        return rhs(t, y)
+
+    return fun
 
 
 def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integration:
@@ -149,6 +187,11 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     if own_steps or (t_out.size and t_out[0] <= 0.0):
         ts.append(np.array([0.0]))
         ys.append(y[:, None].copy())
+    pbar = bar(total=t_end, desc="dynamics", unit="s",
+               bar_format="{desc}: {n:.3g}/{total:.3g} s simulated |{bar}| "
+                          "[{elapsed}<{remaining}, {rate_noinv_fmt}]")
+    # a disabled bar (not a terminal, --quiet) leaves the right-hand side untouched
+    fun = sysm.rhs if pbar.disable else _progress_rhs(sysm.rhs, pbar)
     while t < t_end:
         evs, tags = _events(sysm, in_contact, memory)
         te = None if own_steps else t_out[(t_out > t) & (t_out <= t_end)]
@@ -157,23 +200,27 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
                 # the work integrals have zero Jacobian columns; scipy's finite-difference
                 # step growth overflows harmlessly on them
                 warnings.filterwarnings("ignore", category=RuntimeWarning, module="scipy")
-                sol = solve_ivp(sysm.rhs, (t, t_end), y, method=settings.method, t_eval=te,
+                sol = solve_ivp(fun, (t, t_end), y, method=settings.method, t_eval=te,
                                 events=evs or None, rtol=settings.rtol, atol=atol, **kw)
         except BudgetExceeded as exc:
+            pbar.close()
             raise NumericalError(
                 f"integration stopped at t = {exc.t:.6g} s after {settings.max_rhs_evals} "
-                f"right-hand-side evaluations; {_stiffness_advice(sysm)}") from None
+                f"right-hand-side evaluations; {_stiffness_advice(sysm, settings)}") from None
         except NonFinite as exc:
+            pbar.close()
             raise NumericalError(
-                f"non-finite accelerations at t = {exc.t:.6g} s; {_stiffness_advice(sysm)}"
+                f"non-finite accelerations at t = {exc.t:.6g} s; {_stiffness_advice(sysm, settings)}"
             ) from None
         except np.linalg.LinAlgError:
+            pbar.close()
             raise NumericalError(
                 f"singular constraint Jacobian near t = {t:.6g} s: the mechanism passes a "
                 "dead point; check link lengths and the assembly branch") from None
         if sol.status == -1:
+            pbar.close()
             raise NumericalError(f"integrator failed at t = {sol.t[-1]:.6g} s ({sol.message}); "
-                                 f"{_stiffness_advice(sysm)}")
+                                 f"{_stiffness_advice(sysm, settings)}")
         st = np.asarray(sol.t, float)
         sy = np.asarray(sol.y, float).reshape(y.size, -1)
         if own_steps:
@@ -208,6 +255,9 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
             t, y = float(t_stop), np.array(ye, float)
         else:
             t = t_end
+        if t > pbar.n:
+            pbar.update(t - pbar.n)
+    pbar.close()
     tt = np.concatenate(ts) if ts else np.zeros(0)
     yy = np.concatenate(ys, axis=1) if ys else np.zeros((2 * n + N_AUX, 0))
     return Integration(t=tt, y=yy, onsets=onsets, separations=separations, peaks=peaks,

@@ -61,8 +61,11 @@ def _window(hist, p, rev_hz):
 
 
 def run(params: dict, ctx) -> dict:
+    from dataclasses import replace
+
     from ..errors import warn
     from ..results import atomic_path
+    from . import timescales
     from .analysis import key_outputs, simulate, tolerance_study
     from .build import build_mechanism, solver_settings
     from .signals import (
@@ -82,6 +85,13 @@ def run(params: dict, ctx) -> dict:
     settings = solver_settings(p, 60.0 * rev_hz)
     dt = p["output_step"] or 1.0 / (360.0 * rev_hz)
     t_end = p["end_time"]
+    # contact time scales before the run: refuse what cannot finish within the budget, warn,
+    # and let a failed run's advice name the key that limits the step
+    scales = timescales.joint_time_scales(mech)
+    settings = replace(settings, time_scales=tuple(scales))
+    early_warnings = []
+    for text in timescales.check_budget(scales, t_end, settings.method, settings.max_rhs_evals):
+        warn(text, into=early_warnings)
     tol = p["energy_tolerance"]
     hist = simulate(mech, t_end, dt, settings, energy_tolerance=tol)
     ideal = None
@@ -112,7 +122,7 @@ def run(params: dict, ctx) -> dict:
     res["energy_balance_error"] = hist.energy_error()
     res["constraint_drift_max"] = float(hist.constraint_drift.max())
     joints = {}
-    res["warnings"] = []
+    res["warnings"] = early_warnings
     for cj in mech.system.clearances:
         d = hist.contact[cj.name]
         dur = contact_durations(hist.onsets[cj.name], hist.separations[cj.name])

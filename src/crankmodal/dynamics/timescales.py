@@ -1,0 +1,267 @@
+"""Contact time scales of the clearance joints, estimated before a run.
+
+A journal of effective mass ``m`` pressed into its bore by a law of tangent stiffness ``K_lin``
+oscillates with the contact period ``T_K = 2 pi sqrt(m / K_lin)``; a law with a dashpot ``c``
+relaxes with the damping time ``tau_c = m / c``. An explicit Runge-Kutta integrator is stable
+only while its step ``h`` keeps ``h |lambda|`` inside its stability region (about 3.3 along both
+axes for Dormand-Prince RK45); with the margin its error control keeps, a step of
+``2 / |lambda|`` is taken here: ``h_K = T_K / pi`` (``lambda = i omega_n``) and
+``h_c = 2 tau_c`` (``lambda = -c / m``). The shorter one over the run's ``end_time``, times the
+evaluations per step, bounds the right-hand-side evaluations from below *if the joint is in
+contact the whole time* (the big ends of the four-star and slider-crank scenes are, 80-100 % of
+it, at their loads): a run whose estimate exceeds ``solver.max_rhs_evals`` cannot finish within
+its budget, and the key to change is the one whose time scale is the shorter.
+
+Effective mass: ``1 / lambda_max`` of the 2x2 relative mobility of journal and bearing centres
+(the acceleration of one against the other per unit force pair, through the mass matrix and
+every ideal constraint at the initial state), i.e. the lightest direction; a bearing on the
+ground or a driven crank counts as infinitely heavy through the constraints.
+
+Representative load (for the tangent stiffness of non-linear laws): the larger of the peak gas
+force on a piston and ``m omega**2 r`` (the effective mass on the crank radius at full speed);
+``K_lin`` varies as its ``1 - 1/n`` power (``1/3`` for Hertz), so a rough load is enough.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import contact
+
+#: evaluations of the right-hand side per accepted step of the explicit methods
+EVALS_PER_STEP = {"RK45": 6, "DOP853": 12}
+#: an estimate above this fraction of ``solver.max_rhs_evals`` gives a warning
+WARN_FRACTION = 0.2
+#: an estimate above this multiple of ``solver.max_rhs_evals`` refuses the run: the estimate
+#: takes the lightest direction and contact all the time, so it runs high (measured: 2.3x the
+#: evaluations of the slider-crank at damping = 1e7, 0.75x those of the four-star at
+#: stiffness = 1e12)
+REFUSE_FACTOR = 3.0
+#: laws with a dashpot set by ``contact.damping`` (N s/m); impact: its full damping ``c_max``
+DAMPED_LAWS = ("kelvin_voigt", "power_damped", "impact")
+
+
+@dataclass
+class TimeScale:
+    """Contact time scales of one clearance joint (SI units)."""
+
+    joint: str
+    mass: float            # effective mass, kg
+    load: float            # representative contact force, N
+    k_lin: float           # tangent stiffness at that load, N/m
+    period: float          # T_K = 2 pi sqrt(m / K_lin), s
+    damping: float | None  # dashpot c, N s/m (None: the law has none of its own)
+    damping_time: float | None  # m / c, s
+    law: str
+    stiffness: float       # the law's stiffness parameter (contact.stiffness)
+    exponent: float
+    damping_set: float | None = None  # contact.damping as given, N s/m
+
+    @property
+    def firm(self) -> bool:
+        """Whether the estimate is firm enough to refuse a run: not for ``impact``'s damping,
+        which depends on the penetration the run reaches (:func:`dashpot`)."""
+        return not (self.key == "contact.damping" and self.law == "impact")
+
+    @property
+    def step(self) -> float:
+        """Largest stable explicit step ``min(T_K / pi, 2 m / c)``, s."""
+        h = self.period / np.pi
+        if self.damping_time is not None:
+            h = min(h, 2.0 * self.damping_time)
+        return h
+
+    @property
+    def key(self) -> str:
+        """The scene key whose time scale is the shorter: ``contact.damping`` or ``stiffness``."""
+        if self.damping_time is not None and 2.0 * self.damping_time < self.period / np.pi:
+            return "contact.damping"
+        return "contact.stiffness"
+
+    def describe(self) -> str:
+        """``contact.<key> = value (its time scale)``, for messages."""
+        if self.key == "contact.damping":
+            c = f"{self.damping:.3g} N s/m"
+            if self.law == "impact":  # its STEP ramp: the value set is the full damping
+                c = f"{self.damping_set:.3g} N s/m ({self.damping:.3g} at the static penetration)"
+            return (f"contact.damping = {c} (damping time m/c = {self.damping_time:.2g} s with "
+                    f"the effective mass {self.mass:.3g} kg)")
+        return (f"contact.stiffness = {self.stiffness:.3g} (contact period {self.period:.2g} s "
+                f"with the effective mass {self.mass:.3g} kg at {self.load:.3g} N)")
+
+
+def effective_mass(sysm, cj, q, qd) -> float:
+    """Smallest effective mass of a clearance joint's journal against its bearing, kg.
+
+    ``1 / lambda_max(G)`` with ``G`` the 2x2 relative mobility (m/s^2 per N) of the two centres
+    under a unit force pair, from the constrained equations of motion at ``(q, qd)``.
+    """
+    n = sysm.n
+    M = sysm.mass_matrix(q)
+    _, Cq, _, _ = sysm.generic_constraint_terms(0.0, q, qd)
+    A = np.zeros((n + sysm.m, n + sysm.m))
+    A[:n, :n] = M
+    A[:n, n:] = Cq.T
+    A[n:, :n] = Cq
+    _, Jj, _ = sysm.frame(cj.journal, cj.journal_frame, q, qd)
+    _, Jb, _ = sysm.frame(cj.bearing, cj.bearing_frame, q, qd)
+    G = np.zeros((2, 2))
+    for k in range(2):
+        f = np.zeros(3)
+        f[k] = 1.0
+        Q = np.zeros(n + sysm.m)
+        sysm.add_frame_force(Q[:n], cj.journal, Jj, f)
+        sysm.add_frame_force(Q[:n], cj.bearing, Jb, -f)
+        qdd = np.linalg.lstsq(A, Q, rcond=None)[0][:n]
+        aj = sysm.frame_velocity(cj.journal, Jj, qdd)
+        ab = sysm.frame_velocity(cj.bearing, Jb, qdd)
+        G[:, k] = (aj - ab)[:2]
+    lam = float(np.max(np.linalg.eigvalsh(0.5 * (G + G.T))))
+    return 1.0 / lam if lam > 0.0 else float("inf")
+
+
+def _peak_gas_force(sysm) -> float:
+    peak = 0.0
+    for load in sysm.loads:
+        g = getattr(load, "gas_force", None)
+        if callable(g):
+            a = np.linspace(0.0, 4.0 * np.pi, 1441)
+            peak = max(peak, float(np.max(np.abs([g(x) for x in a]))))
+    return peak
+
+
+def _crank_radius(crank) -> float:
+    pts = [np.asarray(crank.local(f)[0], float) for f in crank.frames]
+    return max((float(np.hypot(*(a - b)[:2])) for a in pts for b in pts), default=0.0)
+
+
+def static_penetration(cj, load: float) -> float:
+    """Penetration at which the joint's elastic force carries ``load`` N, m."""
+    p = cj.law_params
+    K = float(p["stiffness"])
+    if cj.law == "kelvin_voigt":
+        return load / K
+    if cj.law == "johnson_cylinder":
+        return float(contact.johnson_cylinder_approach(load, K, p["radial_clearance"]))
+    return (load / K) ** (1.0 / float(p.get("exponent", 1.5)))
+
+
+def tangent_stiffness(cj, load: float) -> float:
+    """Tangent stiffness of the joint's law at the penetration that carries ``load`` N, N/m."""
+    p = cj.law_params
+    K = float(p["stiffness"])
+    d = static_penetration(cj, load)
+    if cj.law == "kelvin_voigt":
+        return K
+    if cj.law == "johnson_cylinder":
+        return float(contact.johnson_cylinder_stiffness(d, K, p["radial_clearance"]))
+    return float(p.get("exponent", 1.5)) * load / d
+
+
+def dashpot(cj, load: float) -> float:
+    """The law's damping coefficient at the static penetration of ``load``, N s/m (0: none).
+
+    ``impact`` ramps its damping from 0 to ``c_max`` over ``penetration`` (ADAMS STEP): the
+    value at the static penetration is used, and it is an estimate only (the penetration of
+    a run wanders around it; measured: the four-star at ``damping = 1e7`` took 10x fewer
+    evaluations than this damping implies).
+    """
+    if cj.law not in DAMPED_LAWS:
+        return 0.0
+    c = float(cj.law_params.get("damping", 0.0))
+    if cj.law == "impact":
+        d = static_penetration(cj, load)
+        c = float(contact.step(d, 0.0, 0.0, float(cj.law_params["penetration"]), c))
+    return c
+
+
+def joint_time_scales(mech) -> list[TimeScale]:
+    """The time scales of every clearance joint of a mechanism at its initial state."""
+    sysm = mech.system
+    omega = 2.0 * np.pi * mech.revolution_hz
+    gas = _peak_gas_force(sysm)
+    r = _crank_radius(mech.crank)
+    out = []
+    for cj in sysm.clearances:
+        m = effective_mass(sysm, cj, mech.q0, mech.qd0)
+        if not np.isfinite(m):
+            continue
+        load = max(gas, m * omega**2 * r, 1.0)
+        with np.errstate(all="ignore"):  # extreme exponents/stiffnesses: no estimate, no error
+            k = float(np.float64(tangent_stiffness(cj, np.float64(load))))
+            c = float(np.float64(dashpot(cj, np.float64(load))))
+        if not (np.isfinite(k) and k > 0.0 and np.isfinite(c)):
+            continue
+        out.append(TimeScale(
+            joint=cj.name, mass=m, load=load, k_lin=k, period=2.0 * np.pi * np.sqrt(m / k),
+            damping=c if c > 0.0 else None, damping_time=m / c if c > 0.0 else None,
+            law=cj.law, stiffness=float(cj.law_params["stiffness"]),
+            exponent=float(cj.law_params.get("exponent", 1.5)),
+            damping_set=cj.law_params.get("damping") if cj.law in DAMPED_LAWS else None))
+    return out
+
+
+def estimated_evals(ts: TimeScale, t_end: float, method: str) -> float | None:
+    """Right-hand-side evaluations an explicit method needs at step ``ts.step`` over ``t_end``
+    s in contact; None for the implicit methods (LSODA, Radau, BDF: not stability-bound)."""
+    per = EVALS_PER_STEP.get(method)
+    return None if per is None else per * t_end / ts.step
+
+
+def _allowed(ts: TimeScale, h_needed: float) -> str:
+    """The largest value of the responsible key that keeps the step above ``h_needed``."""
+    if ts.key == "contact.damping":
+        return f"<= {2.0 * ts.mass / h_needed:.3g} N s/m"
+    k_lin_max = 4.0 * ts.mass / h_needed**2
+    if ts.law == "kelvin_voigt":
+        k = k_lin_max
+    elif ts.law == "johnson_cylinder":  # K_lin ~ K up to a logarithm
+        return f"about <= {ts.stiffness * k_lin_max / ts.k_lin:.3g} N/m"
+    else:  # K_lin = n K**(1/n) F**(1-1/n)
+        k = ts.stiffness * (k_lin_max / ts.k_lin) ** ts.exponent
+    return f"<= {k:.3g}"
+
+
+def check_budget(scales, t_end: float, method: str, max_rhs_evals: int) -> list[str]:
+    """Refuse a run whose contact time scales need far more evaluations than its budget
+    (:data:`REFUSE_FACTOR` times).
+
+    Returns the warnings for estimates above :data:`WARN_FRACTION` of the budget.
+
+    Raises
+    ------
+    SceneError
+        Exit status 2: the scene as given cannot run within ``solver.max_rhs_evals``, which is
+        known from the input alone before any integration (like ``ring_friction_n`` and
+        ``max_step_deg``), so it is refused as bad input and no results are written.
+    """
+    from ..errors import SceneError
+
+    warnings = []
+    for ts in sorted(scales, key=lambda ts: ts.step):
+        n = estimated_evals(ts, t_end, method)
+        if n is None:
+            continue
+        if n > REFUSE_FACTOR * max_rhs_evals and ts.firm:
+            h_needed = EVALS_PER_STEP[method] * t_end / (REFUSE_FACTOR * max_rhs_evals)
+            raise SceneError(
+                f"dynamics.{ts.key}: {ts.describe()} at joint {ts.joint!r} limits "
+                f"solver.method = {method!r} to steps of {ts.step:.2g} s, at least {n:.3g} "
+                f"right-hand-side evaluations over end_time = {t_end:g} s, more than "
+                f"{REFUSE_FACTOR:g} x solver.max_rhs_evals = {max_rhs_evals}; must be "
+                f"{_allowed(ts, h_needed)} for this budget (or raise solver.max_rhs_evals, shorten end_time, or use "
+                f"solver.method = 'Radau')")
+        if n > WARN_FRACTION * max_rhs_evals:  # incl. the estimates not firm enough to refuse
+            warnings.append(
+                f"dynamics: {ts.describe()} at joint {ts.joint!r} needs steps of {ts.step:.2g} s "
+                f"with solver.method = {method!r}: about {n:.3g} right-hand-side evaluations "
+                f"while in contact ({100 * n / max_rhs_evals:.0f} % of solver.max_rhs_evals); "
+                f"the run may stop at its budget")
+    return warnings
+
+
+def responsible(scales) -> TimeScale | None:
+    """The joint with the shortest stable step (the one that limits an explicit integrator)."""
+    return min(scales, key=lambda ts: ts.step, default=None)
