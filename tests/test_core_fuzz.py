@@ -417,7 +417,6 @@ def not_utf8(text: str) -> dict[str, bytes]:
     return {
         "latin-1": ("# Moteur à café\n" + text).encode("latin-1"),
         "utf-16 with BOM": text.encode("utf-16"),
-        "utf-8 BOM": b"\xef\xbb\xbf" + text.encode(),
         "truncated utf-8": text.encode() + "# €".encode()[:-1],
         "binary junk": random.Random(SEED).randbytes(400),
     }

@@ -246,7 +246,6 @@ def encodings_of(text: str) -> dict[str, bytes]:
     return {
         "latin-1": with_accent.encode("latin-1"),
         "utf-16 with BOM": text.encode("utf-16"),
-        "utf-8 BOM": b"\xef\xbb\xbf" + text.encode(),
         "truncated utf-8 sequence": text.encode() + "# €".encode()[:-1],
         "binary junk": bytes(np.random.default_rng(18).integers(0, 256, 300, dtype=np.uint8)),
     }
@@ -265,6 +264,14 @@ def test_a_scene_that_is_not_utf8_is_one_line_and_removes_stale_results(tmp_path
     line = error_line(*run_cli("run", scene, "--out", out), str(scene), "UTF-8")
     assert not (out / "results.json").exists(), line
     error_line(*run_cli("check", scene), str(scene), "UTF-8")
+
+
+def test_a_scene_with_a_utf8_byte_order_mark_is_read(tmp_path):
+    """A UTF-8 BOM (Notepad writes one) leaves the file UTF-8: it is dropped, not refused."""
+    scene = tmp_path / "s.toml"
+    scene.write_bytes(b"\xef\xbb\xbf" + TORSION.read_bytes())
+    status, stderr = run_cli("check", scene)
+    assert status == 0, stderr
 
 
 def test_a_not_utf8_scene_names_line_and_column(tmp_path):

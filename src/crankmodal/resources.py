@@ -72,7 +72,7 @@ _BOMS = ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
 
 
 def decode_utf8(raw: bytes, path) -> str:
-    """The text of a TOML file, which must be UTF-8 without a byte-order mark (TOML 1.0).
+    """The text of a TOML file, which must be UTF-8 (TOML 1.0); a UTF-8 byte-order mark is dropped.
 
     Raises
     ------
@@ -84,9 +84,9 @@ def decode_utf8(raw: bytes, path) -> str:
         if raw.startswith(bom):
             raise SceneError(f"{path}: {name} text (it starts with a {name} byte-order mark); "
                              "TOML files must be UTF-8: save it as UTF-8")
-    if raw.startswith(codecs.BOM_UTF8):
-        raise SceneError(f"{path}: starts with a UTF-8 byte-order mark, which TOML does not "
-                         "allow: save it as UTF-8 without BOM")
+    # A UTF-8 byte-order mark (Windows editors write one) is still UTF-8: drop it, as
+    # "utf-8-sig" would, instead of refusing a file that is in the right encoding.
+    raw = raw.removeprefix(codecs.BOM_UTF8)
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
