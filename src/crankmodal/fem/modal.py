@@ -35,8 +35,23 @@ COMPLETENESS_STEPS = 8
 #: Extra eigensolver runs allowed for missed modes before giving up.
 MAX_RESCUES = 3
 
-#: A computed mode is rigid when its frequency is below this fraction of the highest computed one.
+#: A computed mode is rigid when its frequency is below this fraction of a reference: the
+#: highest computed one, or with many modes the (rigid + :data:`RIGID_REF_MODES`)-th lowest
+#: (the 50th mode of a clamped 0.3 m bar is 1000x its first, 34 Hz, which counted as rigid).
 RIGID_RATIO = 1e-3
+
+#: Elastic modes above the rigid ones whose highest sets the reference of :data:`RIGID_RATIO`.
+RIGID_REF_MODES = 12
+
+
+def rigid_mask(f: np.ndarray, n_rigid: int = 6) -> np.ndarray:
+    """Which frequencies (any unit) are rigid-body ones: below :data:`RIGID_RATIO` of the
+    ``n_rigid + RIGID_REF_MODES``-th lowest (the highest when there are fewer)."""
+    f = np.abs(np.asarray(f, float))
+    if not len(f):
+        return np.zeros(0, bool)
+    ref = np.sort(f)[min(len(f), n_rigid + RIGID_REF_MODES) - 1]
+    return f < RIGID_RATIO * ref
 
 
 @dataclass
@@ -69,6 +84,10 @@ class Modes:
     n_dofs : int
         Unconstrained degrees of freedom solved for.
     backend : str
+        The sparse factorisation of the Lanczos run (``pardiso``, ``superlu``), or ``dense``
+        when the pencil was solved dense (:func:`use_dense`).
+    eigensolver : str
+        ``lanczos`` (shift-invert, sparse) or ``dense`` (LAPACK, :func:`dense_pairs`).
     timings : dict
         Wall time per phase, s.
     n_solves, solve_time : int, float
@@ -100,6 +119,7 @@ class Modes:
     n_solves: int = 0
     solve_time: float = 0.0
     rigid_mass: np.ndarray | None = None
+    eigensolver: str = "lanczos"
 
     @property
     def band_complete(self) -> bool | None:
@@ -121,6 +141,7 @@ class Modes:
                     ("x_kg", "y_kg", "z_kg", "rx_kgm2", "ry_kgm2", "rz_kgm2"))},
             "total_mass_kg": self.total_mass,
             "backend": self.backend,
+            "eigensolver": self.eigensolver,
             "n_solves": self.n_solves,
             "solve_time_s": self.solve_time,
             "timings_s": self.timings,
@@ -452,21 +473,21 @@ def pair_residuals(KX: np.ndarray, MX: np.ndarray, lam: np.ndarray) -> np.ndarra
     """``‖Kx − λMx‖ / ‖Kx‖`` of each pair; zero-frequency pairs relative to the first elastic one.
 
     A rigid-body mode has ``Kx ≈ 0``: its residual is measured against ``λ_e ‖Mx‖`` with λ_e the
-    smallest eigenvalue above ``RIGID_RATIO`` of the largest frequency, i.e. its strain energy
+    smallest eigenvalue not rigid by :func:`rigid_mask`, i.e. its strain energy
     must be ``tol`` of the first elastic mode's. (Against the shift |σ| ~ 1e-8 λ it would demand
     rounding-free vectors: the stiff part of a 1e-16 noise is ~1e-6 of |σ|.)
     """
     lam = np.asarray(lam, float)
     f = np.sqrt(np.abs(lam))
-    elastic = f >= RIGID_RATIO * f.max() if len(f) else f > 0
+    elastic = ~rigid_mask(f)
     lam_e = lam[elastic].min() if np.any(elastic) else (np.abs(lam).max() or 1.0)
     num = np.linalg.norm(KX - MX * lam, axis=0)
     den = np.maximum(np.linalg.norm(KX, axis=0), abs(lam_e) * np.linalg.norm(MX, axis=0))
     return num / np.where(den > 0, den, 1.0)
 
 
-def check_pairs(K, M, lam, X, tol: float = 1e-6,
-                what: str = "modal") -> tuple[np.ndarray, float]:
+def check_pairs(K, M, lam, X, tol: float = 1e-6, what: str = "modal",
+                advice: str | None = None) -> tuple[np.ndarray, float]:
     """Residuals ‖Kx − λMx‖/‖Kx‖ and M-orthogonality of eigenpairs; raise when poor.
 
     Parameters
@@ -477,6 +498,9 @@ def check_pairs(K, M, lam, X, tol: float = 1e-6,
         Mass-normalised vectors.
     tol : float
         Largest admissible residual (:func:`pair_residuals`) and |XᵀMX − I|.
+    advice : str, optional
+        What to change when the residuals fail, when the cause is known (a nearly
+        incompressible material); default: the mesh, the units, the factorisation.
 
     Returns
     -------
@@ -495,8 +519,9 @@ def check_pairs(K, M, lam, X, tol: float = 1e-6,
         f = np.sqrt(abs(lam[worst])) / (2 * np.pi)
         raise NumericalError(
             f"{what}: eigenpair {worst + 1} ({f:.6g} Hz) has residual ‖Kx−λMx‖/‖Kx‖ = "
-            f"{res[worst]:.2e} > {tol:.0e}; check the mesh for degenerate or inverted elements "
-            f"and for units (points in m, E in Pa), or try backend='superlu'")
+            f"{res[worst]:.2e} > {tol:.0e}; " + (advice or
+            "check the mesh for degenerate or inverted elements and for units (points in m, "
+            "E in Pa), or try backend='superlu'"))
     if not np.isfinite(orth) or orth > tol:
         i, j = np.unravel_index(np.argmax(np.abs(G - np.eye(len(lam)))), G.shape)
         raise NumericalError(
@@ -506,9 +531,265 @@ def check_pairs(K, M, lam, X, tol: float = 1e-6,
     return res, orth
 
 
+#: Free DOF up to which the pencil is solved dense (:func:`dense_pairs`): LAPACK's ``sygvx``
+#: costs ~0.6 s at 1.3k DOF and 1.3-3 s at 1.9-3.5k on the 2 shared cores, against ~0.15 s for
+#: Lanczos, but it has no convergence to fail: Lanczos stalled or overflowed for 50 modes of
+#: several 350-700-DOF bars (the dense oracle agreeing with the modes where it converged).
+DENSE_MAX_DOF = 3000
+
+#: Pairs wanted (rigid included) above this share of the free DOF go dense too, up to
+#: :data:`DENSE_LIMIT_DOF`: 103 modes of a 3465-DOF bar (3 %) did not converge in 452 Lanczos
+#: steps (14 s) where sygvx took 3 s.
+DENSE_FRACTION = 0.02
+
+#: Largest dense problem (K, M and LAPACK's copies: ~1.2 GB; sygvx 23-25 s at 6k DOF).
+DENSE_LIMIT_DOF = 6000
+
+
+def use_dense(n: int, k: int) -> bool:
+    """Whether ``k`` pairs of an ``n``-DOF pencil are better solved dense than by Lanczos."""
+    return n <= DENSE_MAX_DOF or (k > DENSE_FRACTION * n and n <= DENSE_LIMIT_DOF)
+
+
+def dense_pairs(K, M, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest ``k`` eigenpairs of the pencil (K, M) by LAPACK (``scipy.linalg.eigh``).
+
+    For small models, or many modes of a modest one, where a Krylov space of the size needed
+    cannot be built cleanly. Rigid-body pairs are not deflated: they come out with
+    λ ≈ 0 and are separated by the caller's frequency ratio, as the Lanczos ones are checked.
+
+    Parameters
+    ----------
+    K, M : sparse matrices, shape (n, n)
+        Reduced stiffness (N/m) and mass (kg); M positive definite.
+    k : int
+        Pairs wanted, ``1 <= k <= n``.
+
+    Returns
+    -------
+    lam : ndarray, shape (k,)
+        Ascending eigenvalues, rad²/s².
+    X : ndarray, shape (n, k)
+        Their vectors, ``XᵀMX = I``.
+
+    Raises
+    ------
+    NumericalError
+        M is not positive definite (elements of zero or negative volume).
+    """
+    from scipy.linalg import eigh
+
+    from .solvers import check_memory
+
+    n = K.shape[0]
+    check_memory(4 * 8 * n * n, f"modal: the dense eigensolver ({n} DOF)")
+    Kd = K.toarray() if sp.issparse(K) else np.array(K, float)
+    Md = M.toarray() if sp.issparse(M) else np.array(M, float)
+    try:
+        lam, X = eigh(Kd, Md, subset_by_index=[0, k - 1], overwrite_a=True, overwrite_b=True)
+    except np.linalg.LinAlgError as exc:
+        raise NumericalError(f"modal: the dense eigensolver failed ({exc}); M is not positive "
+                             f"definite: look for elements of zero or negative volume") from None
+    return lam, X
+
+
+def rigid_pairs(K, M, Rq: np.ndarray):
+    """The known rigid-body motions as eigenpairs: ``(R, lam_r, Xr)`` with ``R`` the columns of
+    ``Rq`` M-orthonormalised, ``lam_r`` (≈ 0, rad²/s²) and ``Xr`` the Rayleigh–Ritz pairs of
+    (K, M) on them."""
+    L = np.linalg.cholesky(Rq.T @ (M @ Rq))
+    R = np.linalg.solve(L, Rq.T).T
+    lam_r, W = np.linalg.eigh(R.T @ (K @ R))
+    return R, lam_r, R @ W
+
+
+def dense_with_rigid(K, M, Rq: np.ndarray, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`dense_pairs` with the known rigid-body pairs (:func:`rigid_pairs`) in place of
+    LAPACK's: its zero-frequency vectors carry rounding of size eps λ_max, a residual over
+    1e-6 of the first elastic mode for a 200:1 strip; the elastic vectors are M-projected off
+    the exact rigid ones. A zero mode the connectivity did not predict stays among the
+    elastic ones, for the caller's rigid count to catch."""
+    r = Rq.shape[1]
+    lam, X = dense_pairs(K, M, r + n_modes)
+    _, lam_r, Xr = rigid_pairs(K, M, Rq)
+    Xe = X[:, r:]
+    Xe -= Xr @ ((M @ Xr).T @ Xe)
+    Xe /= np.sqrt(np.einsum("ij,ij->j", Xe, M @ Xe))
+    return np.r_[lam_r, lam[r:]], np.hstack([Xr, Xe])
+
+
+def refine_pairs(K, M, X: np.ndarray, sigma: float, backend: str = "auto",
+                 R: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """One step of shift-invert subspace iteration and Rayleigh–Ritz on the columns of ``X``.
+
+    A dense eigensolver's pairs have a normwise backward error ``eps ‖K‖``: relative to the
+    lowest modes' ``‖Kx‖`` that is ``eps λ_max / λ``, over 1e-6 for a 200:1 strip (1.2e-6 at
+    133 Hz). ``(K − σM)⁻¹ M`` shrinks each error component by ``(λ − σ)/(λ_j − σ)``: one step
+    (one sparse factorisation, ``k`` solves) brings the residuals to the Lanczos ones.
+
+    Parameters
+    ----------
+    K, M : sparse matrices
+    X : ndarray, shape (n, k)
+        Approximate eigenvectors.
+    sigma : float
+        Shift, rad²/s², below the lowest eigenvalue of the span.
+    backend : str
+        Sparse factorisation (:mod:`crankmodal.fem.solvers`).
+    R : ndarray, shape (n, r), optional
+        M-orthonormal vectors to keep out (the rigid-body modes).
+
+    Returns
+    -------
+    lam : ndarray, shape (k,)
+        Ascending, rad²/s².
+    X : ndarray, shape (n, k)
+        M-orthonormal.
+    """
+    from scipy.linalg import eigh
+
+    from .solvers import factorize_shifted
+
+    try:
+        fac = factorize_shifted(K, M, sigma, backend, positive_definite=True, label="modal: ")
+    except np.linalg.LinAlgError as exc:
+        raise NumericalError(f"modal: factorising K - σM failed ({exc}); the mesh may have "
+                             f"inverted elements, or an extra mechanism") from None
+    Y = fac.solve(M @ X)
+    del fac
+    if R is not None and R.shape[1]:
+        Y -= R @ ((M @ R).T @ Y)
+    Y /= np.sqrt(np.einsum("ij,ij->j", Y, M @ Y))  # columns of one scale for the small pencil
+    Kr, Mr = Y.T @ (K @ Y), Y.T @ (M @ Y)
+    lam, W = eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
+    return sort_and_normalise(lam, Y @ W, M)
+
+
+def lanczos_pairs(model: FEModel, K, M, Rq: np.ndarray, deflate: bool, k: int,
+                  shift: float | None, backend: str, tol: float, timings: dict):
+    """Lowest ``k`` pairs of the reduced pencil by shift-invert Lanczos (one sparse factor).
+
+    With ``deflate`` the columns of ``Rq`` (the rigid-body motions) are M-orthonormalised and
+    kept out of the Krylov space, ``k`` counts elastic pairs only, and the rigid pairs are
+    added to the result.
+
+    Returns
+    -------
+    lam, X, K, M, backend_name, n_solves, solve_time
+        Eigenvalues (rad²/s², unsorted), M-orthonormal vectors, K and M as
+        :class:`~crankmodal.fem.parallel.RowBlocks`, the factorisation's name, its solves and
+        their wall time (s).
+    """
+    from threadpoolctl import threadpool_limits
+
+    from .solvers import factorize_shifted
+
+    n = K.shape[0]
+    sigma = default_shift(K, M) if shift is None else float(shift)
+    if sigma >= 0:
+        raise SceneError(f"modal.shift: must be < 0, got {sigma}")
+    t0 = time.perf_counter()
+    try:
+        fac = factorize_shifted(K, M, sigma, backend, positive_definite=True,
+                                label="modal: ")
+    except np.linalg.LinAlgError as exc:
+        raise NumericalError(f"modal: factorising K - σM failed ({exc}); the mesh may have "
+                             f"inverted elements, or an extra mechanism") from None
+    timings["factorize_s"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    K, M = RowBlocks(K), RowBlocks(M)  # products on every core: the loop's M·w, the checks
+    n_solves, solve_time = [0], [0.0]
+    rng = np.random.default_rng(20240607)  # fixed: repeatable modes
+    if deflate:  # the rigid modes are known: M-orthonormalise them and keep them out
+        Rq, lam_r, Xr = rigid_pairs(K, M, Rq)
+    R0 = Rq if deflate else np.zeros((n, 0))  # M-orthonormal, kept out of the Krylov space
+    MR0 = M @ R0
+
+    def solve(b, _fac=fac):
+        n_solves[0] += 1
+        t = time.perf_counter()
+        x = _fac.solve(b)
+        solve_time[0] += time.perf_counter() - t
+        return x
+
+    last = {}
+
+    def accept(theta, X, MX):
+        """Pencil residuals of the candidate pairs 10x inside the final check (zero-frequency
+        ones, whose residual is a rounding floor that more steps do not lower: inside it) —
+        or inside it and no longer falling: a floor set by rounding, which more steps only
+        pay for (with the rigid modes in the Krylov space, 1e8 times the elastic θ, it sat
+        at 1.3-1.8e-7 on a 12k-DOF bar while 10x inside asked for 1e-7)."""
+        lam_c = sigma + 1.0 / theta
+        f = np.sqrt(np.abs(lam_c))
+        margin = np.where(rigid_mask(f), 1.0, 0.1)
+        r = pair_residuals(K @ X, MX, lam_c)
+        before, last["r"] = last.get("r"), r
+        last.setdefault("first", float(r.max()))
+        if np.all(r <= margin * tol):
+            return True
+        return (before is not None and len(before) == len(r) and bool(np.all(r <= tol))
+                and r.max() > 0.5 * before.max())
+
+    def run(op, k_run, start, room):
+        """Lowest k_run modes of the deflated pencil (raises when Lanczos does not converge)."""
+        steps = min(room, max(4 * k_run + 40, 60))
+        last.clear()  # the floor test compares calls within one run
+        out = lanczos(op, M, start(), k_run, LANCZOS_TOL, steps, fresh=start, accept=accept)
+        if (not out.converged and "r" in last and model.material.nu < NU_ILL_CONDITIONED
+                and last["r"].max() < 0.5 * last["first"]):
+            # still falling when the steps ran out: too many modes for one run, not rounding
+            raise NumericalError(
+                f"modal: {k_run} modes did not converge in {out.steps} Lanczos steps (eigen-"
+                f"residual {last['r'].max():.1e} > tol = {tol:.0e}, still falling): ask for "
+                f"fewer modes (modal.n_modes; {k_run} of {n} DOF), or loosen modal.tol")
+        r = last.get("r")
+        if (not out.converged and r is not None and model.material.nu < NU_ILL_CONDITIONED
+                and len(r) > 1 and r[:len(r) // 2].max() <= tol):
+            # the lowest pairs are fine, the highest sit on a floor: 103 modes of a 3.5k-DOF
+            # bar stalled at 4e-4 where the dense solver's residuals were 1e-9 (not the mesh)
+            raise NumericalError(
+                f"modal: the eigen-residuals of the highest of {k_run} modes stall at "
+                f"{r.max():.1e} > tol = {tol:.0e} (the lowest {len(r) // 2} are within it): "
+                f"shift-invert Lanczos cannot resolve that many modes of {n} DOF; ask for fewer "
+                f"(modal.n_modes), loosen modal.tol, or use modal.eigensolver = 'dense'")
+        if not out.converged and "r" in last:  # the Lanczos estimates converged, the pairs not
+            raise NumericalError(
+                f"modal: the eigen-residuals ‖Kx − λMx‖/‖Kx‖ stall at {last['r'].max():.1e} "
+                f"> tol = {tol:.0e}: K is too ill-conditioned for double precision — "
+                + stall_advice(model))
+        if not out.converged:
+            raise NumericalError(
+                f"modal: {k_run} modes did not converge in {out.steps} Lanczos steps "
+                f"(largest relative residual {np.max(out.residuals / np.abs(out.theta)):.1e});"
+                + (" " + stall_advice(model) if model.material.nu >= NU_ILL_CONDITIONED else
+                   " check the mesh for loose or degenerate elements, or ask for fewer modes"))
+        return out
+
+    # one BLAS thread for the small dense work of the loop (two were 5-7x slower); PARDISO
+    # sets its own MKL threads per call
+    with threadpool_limits(limits=1, user_api="blas"):
+        def fresh():
+            return rng.standard_normal(n)
+
+        op, start = deflated(solve, fresh, R0, MR0)
+        main = run(op, k, start, n - R0.shape[1])
+        lam, X, _ = complete_modes(solve, fresh, M, run, sigma + 1.0 / main.theta,
+                                   main.vectors, main.m_vectors, sigma, k,
+                                   kept=(R0, MR0) if R0.shape[1] else None)
+    if deflate:
+        lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
+    backend_name = fac.name
+    del solve, fac  # free the factor before the checks' n × k products
+    timings["lanczos_s"] = time.perf_counter() - t0
+    return lam, X, K, M, backend_name, n_solves[0], solve_time[0]
+
+
 def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                 backend: str = "auto", band: tuple | None = None, shift: float | None = None,
-                tol: float = 1e-6, expected_rigid: int | None = None) -> Modes:
+                tol: float = 1e-6, expected_rigid: int | None = None,
+                eigensolver: str = "auto") -> Modes:
     """Lowest ``n_modes`` elastic modes of a model, free or supported.
 
     Parameters
@@ -528,15 +809,13 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         Admissible residual and M-orthogonality defect.
     expected_rigid : int, optional
         Rigid-body modes to expect (default: from the mesh connectivity and the supports).
+    eigensolver : str
+        ``auto`` (:func:`use_dense` decides), ``lanczos`` or ``dense``.
 
     Returns
     -------
     Modes
     """
-    from threadpoolctl import threadpool_limits
-
-    from .solvers import factorize_shifted
-
     if n_modes < 1:
         raise SceneError(f"modal.n_modes: must be >= 1, got {n_modes}")
     timings: dict = {}
@@ -550,101 +829,44 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         deflate = expected_rigid is None and Rq.shape[1] > 0
         n = K.shape[0]
         k = n_modes if deflate else n_rigid_expected + n_modes
-        if k >= n - 1:
-            raise SceneError(f"modal.n_modes: {n_modes} modes need a finer mesh "
-                             f"(only {n} free DOFs)")
-        sigma = default_shift(K, M) if shift is None else float(shift)
-        if sigma >= 0:
-            raise SceneError(f"modal.shift: must be < 0, got {sigma}")
+        n_elastic = n - n_rigid_expected
+        if n_modes > n_elastic:
+            raise SceneError(
+                f"modal.n_modes: {n_modes} elastic modes asked, but the part has only "
+                f"{n_elastic} ({n} free DOF less {n_rigid_expected} rigid-body modes); ask for at "
+                f"most {n_elastic}, or refine the mesh")
         timings["reduce_s"] = time.perf_counter() - t0
 
-        t0 = time.perf_counter()
-        try:
-            fac = factorize_shifted(K, M, sigma, backend, positive_definite=True,
-                                    label="modal: ")
-        except np.linalg.LinAlgError as exc:
-            raise NumericalError(f"modal: factorising K - σM failed ({exc}); the mesh may have "
-                                 f"inverted elements, or an extra mechanism") from None
-        timings["factorize_s"] = time.perf_counter() - t0
-
-        t0 = time.perf_counter()
-        K, M = RowBlocks(K), RowBlocks(M)  # products on every core: the loop's M·w, the checks
-        n_solves, solve_time = [0], [0.0]
-        rng = np.random.default_rng(20240607)  # fixed: repeatable modes
-        if deflate:  # the rigid modes are known: M-orthonormalise them and keep them out
-            L = np.linalg.cholesky(Rq.T @ (M @ Rq))
-            Rq = np.linalg.solve(L, Rq.T).T
-            lam_r, W = np.linalg.eigh(Rq.T @ (K @ Rq))
-            Xr = Rq @ W
-        R0 = Rq if deflate else np.zeros((n, 0))  # M-orthonormal, kept out of the Krylov space
-        MR0 = M @ R0
-
-        def solve(b, _fac=fac):
-            n_solves[0] += 1
-            t = time.perf_counter()
-            x = _fac.solve(b)
-            solve_time[0] += time.perf_counter() - t
-            return x
-
-        last = {}
-
-        def accept(theta, X, MX):
-            """Pencil residuals of the candidate pairs 10x inside the final check (zero-frequency
-            ones, whose residual is a rounding floor that more steps do not lower: inside it) —
-            or inside it and no longer falling: a floor set by rounding, which more steps only
-            pay for (with the rigid modes in the Krylov space, 1e8 times the elastic θ, it sat
-            at 1.3-1.8e-7 on a 12k-DOF bar while 10x inside asked for 1e-7)."""
-            lam_c = sigma + 1.0 / theta
-            f = np.sqrt(np.abs(lam_c))
-            margin = np.where(f < RIGID_RATIO * f.max(), 1.0, 0.1)
-            r = pair_residuals(K @ X, MX, lam_c)
-            before, last["r"] = last.get("r"), r
-            if np.all(r <= margin * tol):
-                return True
-            return (before is not None and len(before) == len(r) and bool(np.all(r <= tol))
-                    and r.max() > 0.5 * before.max())
-
-        def run(op, k_run, start, room):
-            """Lowest k_run modes of the deflated pencil (raises when Lanczos does not converge)."""
-            steps = min(room, max(4 * k_run + 40, 60))
-            last.clear()  # the floor test compares calls within one run
-            out = lanczos(op, M, start(), k_run, LANCZOS_TOL, steps, fresh=start, accept=accept)
-            if not out.converged and "r" in last:  # the Lanczos estimates converged, the pairs not
-                raise NumericalError(
-                    f"modal: the eigen-residuals ‖Kx − λMx‖/‖Kx‖ stall at {last['r'].max():.1e} "
-                    f"> tol = {tol:.0e}: K is too ill-conditioned for double precision — "
-                    + stall_advice(model))
-            if not out.converged:
-                raise NumericalError(
-                    f"modal: {k_run} modes did not converge in {out.steps} Lanczos steps "
-                    f"(largest relative residual {np.max(out.residuals / np.abs(out.theta)):.1e});"
-                    + (" " + stall_advice(model) if model.material.nu >= NU_ILL_CONDITIONED else
-                       " check the mesh for loose or degenerate elements, or ask for fewer modes"))
-            return out
-
-        # one BLAS thread for the small dense work of the loop (two were 5-7x slower); PARDISO
-        # sets its own MKL threads per call
-        with threadpool_limits(limits=1, user_api="blas"):
-            def fresh():
-                return rng.standard_normal(n)
-
-            op, start = deflated(solve, fresh, R0, MR0)
-            main = run(op, k, start, n - R0.shape[1])
-            lam, X, _ = complete_modes(solve, fresh, M, run, sigma + 1.0 / main.theta,
-                                       main.vectors, main.m_vectors, sigma, k,
-                                       kept=(R0, MR0) if R0.shape[1] else None)
-        if deflate:
-            lam, X = np.r_[lam_r, lam], np.hstack([Xr, X])
-        backend_name = fac.name
-        del solve, fac  # free the factor before the checks' n × k products
-        timings["lanczos_s"] = time.perf_counter() - t0
+        if eigensolver not in ("auto", "lanczos", "dense"):
+            raise SceneError(f"modal.eigensolver: must be auto, lanczos or dense; got {eigensolver!r}")
+        if eigensolver == "dense" or (eigensolver == "auto"
+                                      and use_dense(n, n_rigid_expected + n_modes)):
+            t0 = time.perf_counter()
+            if deflate:
+                lam, X = dense_with_rigid(K, M, Rq, n_modes)
+            else:
+                lam, X = dense_pairs(K, M, n_rigid_expected + n_modes)
+            r = Rq.shape[1] if deflate else 0
+            sigma = default_shift(K, M) if shift is None else float(shift)
+            lam_e, X_e = refine_pairs(K, M, X[:, r:], sigma, backend, R=X[:, :r])
+            lam, X = np.r_[lam[:r], lam_e], np.hstack([X[:, :r], X_e])
+            timings.update(factorize_s=0.0, lanczos_s=0.0, dense_s=time.perf_counter() - t0)
+            backend_name, eigensolver, n_solves, solve_time = "dense", "dense", 0, 0.0
+        else:
+            lam, X, K, M, backend_name, n_solves, solve_time = lanczos_pairs(
+                model, K, M, Rq, deflate, k, shift, backend, tol, timings)
+            eigensolver = "lanczos"
 
         t0 = time.perf_counter()
         order = np.argsort(lam)  # M-orthonormal already (Lanczos, rigid basis): check_pairs checks
         lam, X = lam[order], X[:, order]
-        res, orth = check_pairs(K, M, lam, X, tol=tol)
+        advice = None
+        if eigensolver == "dense" or model.material.nu >= NU_ILL_CONDITIONED:
+            # LAPACK's dense solution is backward stable: poor pairs are the model's conditioning
+            advice = "K is too ill-conditioned for double precision — " + stall_advice(model)
+        res, orth = check_pairs(K, M, lam, X, tol=tol, advice=advice)
         f = np.sqrt(np.abs(lam)) / (2 * np.pi)
-        rigid = f < RIGID_RATIO * f.max()
+        rigid = rigid_mask(f, n_rigid_expected)
         n_rigid = int(rigid.sum())
         if not np.all(rigid[:n_rigid]) or n_rigid != n_rigid_expected:
             raise NumericalError(
@@ -669,5 +891,5 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
                  rigid_frequencies_hz=f[:n_rigid], residuals=res[n_rigid:],
                  orthogonality=orth, effective_mass=gamma ** 2, total_mass=mtot, n_dofs=n,
                  backend=backend_name, timings=timings, memory=mem.to_dict(), in_band=in_band,
-                 band=tuple(band) if band is not None else None, n_solves=n_solves[0],
-                 solve_time=solve_time[0], rigid_mass=rigid_mass)
+                 band=tuple(band) if band is not None else None, n_solves=n_solves,
+                 solve_time=solve_time, rigid_mass=rigid_mass, eigensolver=eigensolver)

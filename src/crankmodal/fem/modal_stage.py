@@ -1,7 +1,7 @@
 """The ``[modal]`` scene section: free-free or supported natural frequencies and mode shapes.
 
 Fixed keys (../shared/SCENES.md): ``n_modes``, ``supports``. Own keys: ``band``, ``backend``,
-``tol``, ``axis``, ``vtu``. Results: ``frequencies_hz`` (elastic, ascending, ``n_modes``),
+``eigensolver``, ``tol``, ``axis``, ``vtu``. Results: ``frequencies_hz`` (elastic, ascending, ``n_modes``),
 ``rigid_body_modes``, ``n_dofs``, ``n_elements``, mode ``classes``, effective masses, residual
 and orthogonality checks, timings per phase, peak memory; mode shapes to ``modes.vtu``.
 """
@@ -28,6 +28,9 @@ SCHEMA: dict[str, Field] = {
                   "warns when the modes computed stop below f_max)",
                   length=2, check=_band_check),
     "backend": BACKEND_FIELD,
+    "eigensolver": Field("str", "auto", "auto (dense for small models or many modes), lanczos "
+                         "(sparse shift-invert) or dense (LAPACK, then one refinement step)",
+                         choices=("auto", "lanczos", "dense")),
     "tol": Field("float", 1e-6, "largest admissible eigen-residual and M-orthogonality defect",
                  gt=0.0, lt=1.0),
     "axis": Field("floats", None, "long axis for naming modes (default: principal axis)", length=3),
@@ -55,7 +58,7 @@ def run(p: dict, ctx) -> dict:
         model, t_asm = timed_fe_model(ctx, part, mat)
         sup = select(part, p["supports"], SECTION)
         modes = solve_modes(model, p["n_modes"], sup, backend=p["backend"],
-                            band=p["band"], tol=p["tol"])
+                            band=p["band"], tol=p["tol"], eigensolver=p["eigensolver"])
         classes = classify(model.points[model.used], modes.shapes.reshape(-1, 3, modes.shapes.shape[1])
                            [model.used].reshape(-1, modes.shapes.shape[1]), axis=p["axis"])
     ctx.products[SECTION] = modes
@@ -89,5 +92,6 @@ def run(p: dict, ctx) -> dict:
     kind = "free-free" if not sup else f"{len(sup)} supports"
     res["summary"] = (f"{len(f)} elastic modes ({kind}, {modes.rigid_body_modes} rigid), "
                       f"{f[0]:.1f}-{f[-1]:.1f} Hz; {modes.n_dofs} DOF, "
-                      f"{sum(res['timings_s'][k] for k in ('assembly_total_s', 'reduce_s', 'factorize_s', 'lanczos_s')):.1f} s")
+                      f"{sum(res['timings_s'].get(k, 0.0) for k in ('assembly_total_s', 'reduce_s', 'factorize_s', 'lanczos_s', 'dense_s')):.1f} s"
+                      + (" (dense eigensolver)" if modes.eigensolver == "dense" else ""))
     return res

@@ -1,0 +1,195 @@
+"""FE hardening (issue 18, items 10-13): non-finite mesh files, the dense eigensolver for small
+models or many modes, a support that leaves nothing free, and what repeats bit for bit."""
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+from crankmodal.errors import InputFileError, SceneError
+from crankmodal.fem import assembly, modal, supports
+from crankmodal.fem.materials import material
+from crankmodal.fem.testparts import bar
+from crankmodal.geometry.importers import import_mesh
+
+STEEL = material("steel")
+
+
+def _write_vtu(path, points, cells, kind="tetra"):
+    import meshio
+
+    meshio.write(path, meshio.Mesh(np.asarray(points, float), [(kind, np.asarray(cells))]))
+    return path
+
+
+def _small_bar():
+    part = bar(0.1, 0.02, 0.02, (4, 1, 1), order=1)
+    p, t = np.array(part.mesh.points, float), np.array(part.mesh.cells[0].data)
+    e = p[t[:, 1:]] - p[t[:, :1]]
+    flip = np.linalg.det(e) < 0  # the structured grid's tets are not all positively oriented
+    t[flip, 1], t[flip, 2] = t[flip, 2], t[flip, 1].copy()
+    return p, t
+
+
+# --- item 10: a mesh file with a NaN coordinate ---------------------------------------------
+
+def test_a_nan_coordinate_in_a_mesh_file_stops_run_with_exit_2_naming_file_and_point(tmp_path,
+                                                                                     cli):
+    """Before: exit 2 blaming 'inverted elements (check its node order)', after a numpy
+    RuntimeWarning; the tester's LinAlgError traceback came from the same NaN."""
+    points, cells = _small_bar()
+    points[3, 1] = np.nan
+    _write_vtu(tmp_path / "nan.vtu", points, cells)
+    (tmp_path / "nan.toml").write_text(textwrap.dedent("""\
+        [geometry]
+        file = "nan.vtu"
+        [material]
+        name = "steel"
+        [modal]
+        n_modes = 4
+        """))
+    out = tmp_path / "out"
+    r = cli("--quiet", "run", tmp_path / "nan.toml", "--out", out, cwd=tmp_path,
+            warnings="default")
+    assert r.returncode == 2, r.stderr
+    lines = [ln for ln in r.stderr.splitlines() if ln.startswith("crankmodal: error")]
+    assert len(lines) == 1 and "Traceback" not in r.stderr and "Warning" not in r.stderr, r.stderr
+    assert "geometry.file: nan.vtu: point 3 has a non-finite coordinate" in lines[0]
+    assert "nan" in lines[0].split("coordinate")[1]
+    assert not (out / "results.json").exists()
+
+
+@pytest.mark.parametrize("value", [np.inf, -np.inf])
+def test_an_infinite_coordinate_is_refused_by_name(tmp_path, value):
+    points, cells = _small_bar()
+    points[7, 0] = value
+    path = _write_vtu(tmp_path / "inf.vtu", points, cells)
+    with pytest.raises(InputFileError, match=r"inf\.vtu: point 7 has a non-finite coordinate "
+                                             r"\[ *-?inf"):
+        import_mesh(path)
+
+
+def test_a_non_finite_point_no_cell_uses_is_dropped_not_refused(tmp_path):
+    points, cells = _small_bar()
+    path = _write_vtu(tmp_path / "loose.vtu", np.vstack([points, [np.nan, 0, 0]]), cells)
+    part = import_mesh(path)
+    assert len(part.mesh.points) == len(points) and np.all(np.isfinite(part.mesh.points))
+
+
+def test_a_cell_naming_a_missing_point_is_refused_by_name(tmp_path):
+    points, cells = _small_bar()
+    cells = np.array(cells)
+    cells[5, 2] = len(points) + 10
+    path = _write_vtu(tmp_path / "holes.vtu", points, cells)
+    with pytest.raises(InputFileError, match=rf"holes\.vtu: volume cell 5 refers to point "
+                                             rf"{len(points) + 10}, but the file has "
+                                             rf"{len(points)} points"):
+        import_mesh(path)
+
+
+def test_a_mesh_without_volume_cells_is_refused(tmp_path):
+    points, _ = _small_bar()
+    path = _write_vtu(tmp_path / "skin.vtu", points, [[0, 1, 2]], kind="triangle")
+    with pytest.raises(InputFileError, match=r"skin\.vtu must hold tetra or tetra10 cells"):
+        import_mesh(path)
+
+
+# --- item 11: small models and many modes go to a dense eigensolver ---------------------------
+
+def _clamped_570():
+    """The issue's case: 570 DOF (a 0.3 m bar, 18 x 1 x 4 P1 cells), clamped at one end."""
+    part = bar(0.3, 0.02, 0.06, (18, 1, 4), order=1)
+    model = assembly.assemble(part, STEEL)
+    return model, [supports.Support("end_x0", np.asarray(part.regions["end_x0"].nodes), "xyz")]
+
+
+def _dense_oracle_hz(model, sup, k):
+    T = supports.reduction(model.points, model.used, sup)
+    K = (T.T @ model.K @ T).toarray()
+    M = (T.T @ model.M @ T).toarray()
+    lam = sla.eigh(K, M, eigvals_only=True, subset_by_index=[0, k - 1])
+    return np.sqrt(np.abs(lam)) / (2 * np.pi)
+
+
+def test_fifty_modes_of_a_570_dof_bar_match_the_dense_oracle_and_pass_the_checks():
+    """Before: exit 3 'K is too ill-conditioned ... flat or needle elements' with numpy overflow
+    warnings (Lanczos asked for 50 of 555 free DOF)."""
+    model, sup = _clamped_570()
+    m = modal.solve_modes(model, 50, sup)
+    np.testing.assert_allclose(m.frequencies_hz, _dense_oracle_hz(model, sup, 50), rtol=1e-9)
+    assert m.residuals.max() < 1e-8 and m.orthogonality < 1e-10
+    assert m.eigensolver == "dense" and m.rigid_body_modes == 0
+    out = m.to_dict()
+    assert out["eigensolver"] == "dense" and out["backend"] == "dense"
+
+
+def test_many_free_free_modes_of_a_small_bar_keep_six_rigid_ones_apart():
+    """80 modes of a 570-DOF free bar stalled at 'residual 1.0e+00' before; the 50th mode of a
+    clamped bar is 1000x its first, which the rigid-mode test counted as rigid."""
+    model = assembly.assemble(bar(1.0, 0.05, 0.04, (18, 1, 4), order=1), STEEL)
+    m = modal.solve_modes(model, 80)
+    assert m.rigid_body_modes == 6 and len(m.frequencies_hz) == 80
+    np.testing.assert_allclose(m.frequencies_hz, _dense_oracle_hz(model, [], 86)[6:], rtol=1e-9)
+    assert m.residuals.max() < 1e-8
+
+
+def test_lanczos_and_dense_agree_just_above_the_crossover():
+    model = assembly.assemble(bar(1.0, 0.05, 0.04, (20, 2, 2), order=2), STEEL)  # 3075 DOF
+    assert modal.use_dense(3000, 18) and not modal.use_dense(3075, 18)
+    lz = modal.solve_modes(model, 12)
+    dn = modal.solve_modes(model, 12, eigensolver="dense")
+    assert (lz.eigensolver, dn.eigensolver) == ("lanczos", "dense")
+    np.testing.assert_allclose(lz.frequencies_hz, dn.frequencies_hz, rtol=1e-9)
+    assert lz.residuals.max() < 1e-6 and dn.residuals.max() < 1e-6
+
+
+def test_n_modes_above_the_free_elastic_dof_count_is_refused_naming_the_count():
+    model = assembly.assemble(bar(0.1, 0.02, 0.02, (4, 1, 1), order=1), STEEL)  # 60 DOF
+    assert len(modal.solve_modes(model, 54).frequencies_hz) == 54  # every elastic mode
+    with pytest.raises(SceneError, match=r"modal\.n_modes: 55 elastic modes asked, but the part "
+                                         r"has only 54 \(60 free DOF less 6 rigid-body"):
+        modal.solve_modes(model, 55)
+
+
+# --- item 12: a support that holds every node --------------------------------------------------
+
+def test_a_support_box_holding_every_node_says_nothing_is_left_free():
+    """Before: 'modal.n_modes: 4 modes need a finer mesh (only 0 free DOFs)'."""
+    part = bar(0.1, 0.02, 0.02, (4, 1, 1), order=1)
+    model = assembly.assemble(part, STEEL)
+    sup = supports.select(part, [{"box": [-1, 1, -1, 1, -1, 1]}])
+    with pytest.raises(SceneError, match=r"modal\.supports\[0\] \(box\): holds every node .* "
+                                         r"nothing is left free"):
+        modal.solve_modes(model, 4, sup)
+
+
+# --- item 13: what repeats bit for bit --------------------------------------------------------
+
+_REPEAT = """
+import hashlib, sys, warnings
+warnings.simplefilter("ignore")
+import numpy as np
+from crankmodal.fem import assembly, modal
+from crankmodal.fem.materials import material
+from crankmodal.fem.testparts import bar
+m = assembly.assemble(bar(1.0, 0.05, 0.04, (12, 2, 2), order=2), material("steel"))
+out = {}
+for solver in ("lanczos", "dense"):
+    r = modal.solve_modes(m, 12, eigensolver=solver)
+    # a shape's sign is arbitrary but fixed by the start vector: hash it as computed
+    out[solver] = hashlib.sha256(r.frequencies_hz.tobytes() + r.shapes.tobytes()).hexdigest()
+print(out)
+"""
+
+
+def test_two_concurrent_processes_give_bit_identical_modes_for_the_same_mesh():
+    """The README's claim: bit for bit for the same mesh and thread count, PARDISO on every
+    core and the row-block products included (two processes compete for the 2 cores)."""
+    procs = [subprocess.Popen([sys.executable, "-c", _REPEAT], stdout=subprocess.PIPE, text=True)
+             for _ in range(2)]
+    outs = [p.communicate(timeout=300)[0].strip() for p in procs]
+    assert all(p.returncode == 0 for p in procs)
+    assert outs[0] == outs[1] and "lanczos" in outs[0] and "dense" in outs[0], outs
