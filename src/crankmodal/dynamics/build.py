@@ -84,7 +84,9 @@ def build_mechanism(p, mechanism_params=None):
         check_ring_friction(p["ring_friction_n"], src["cylinders"])
         speed = p["speed_rpm"] or src["speed_rpm"]
         common = _common(p, speed, specs, kw, src["direction"])
-        com = src["crank_unbalance"] / ct["crank_mass"] if ct["crank_mass"] > 0 else 0.0
+        # the mechanism's unbalance at the pin, less a counterweight opposite it (both kg m)
+        mr = src["crank_unbalance"] - ct["counterweight_mass_radius"]
+        com = mr / ct["crank_mass"] if ct["crank_mass"] > 0 else 0.0
         return crank_train(src["crank_radius"], src["cylinders"], crank_mass=ct["crank_mass"],
                            crank_inertia=ct["crank_inertia"], crank_com=com, kind=p["mechanism"],
                            **common)
@@ -106,7 +108,9 @@ def build_mechanism(p, mechanism_params=None):
             for a, zi in zip(angles, z)]
     check_ring_friction(p["ring_friction_n"], cyls)
     return crank_train(ct["crank_radius"], cyls, crank_mass=ct["crank_mass"],
-                       crank_inertia=ct["crank_inertia"], crank_com=ct["crank_com"],
+                       crank_inertia=ct["crank_inertia"],
+                       crank_com=ct["crank_com"] - (ct["counterweight_mass_radius"] / ct["crank_mass"]
+                                                    if ct["crank_mass"] > 0 else 0.0),
                        kind=p["mechanism"], **common)
 
 

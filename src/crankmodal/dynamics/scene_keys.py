@@ -68,6 +68,9 @@ CRANK_TRAIN = {
     "crank_inertia": Field("float", 0.0, "kg m^2 about its centre of mass (add the flywheel here)",
                            ge=0.0),
     "crank_com": Field("float", 0.0, "centre of mass from the axis along the crank, m", ),
+    "counterweight_mass_radius": Field("float", 0.0, "counterweight mass x radius opposite the "
+                                       "crankpin, kg m (part of crank_mass: its centre of mass "
+                                       "moves by -this/crank_mass)", ge=0.0),
     "offset": Field("float", 0.0, "piston-pin offset across the cylinder axis, m"),
     "cylinder_angles_deg": Field("floats", None, "cylinder axis angles from x, deg (slider_crank "
                                  "[0], four_star [90, 270, 0, 180])"),
@@ -232,6 +235,11 @@ def _cross_checks(p):
     if fr["law"] != "none" and fr["v_dynamic"] <= fr["v_static"]:
         raise SceneError("dynamics.friction.v_dynamic: must be > v_static "
                          f"({fr['v_static']:g} m/s)")
+    if ct["counterweight_mass_radius"] > 0 and p["mechanism"] != "four_bar" \
+            and ct["crank_mass"] <= 0:
+        raise SceneError("dynamics.crank_train.counterweight_mass_radius: needs crank_mass > 0 "
+                         "(kg; the counterweight is part of the crank's mass), got crank_mass = "
+                         f"{ct['crank_mass']:g}")
     if p["drive_torque"] is not None and p["mechanism"] != "four_bar" and ct["crank_inertia"] <= 0:
         raise SceneError("dynamics.crank_train.crank_inertia: must be > 0 (crank and flywheel, "
                          "kg m^2) when drive_torque sets the speed free")
