@@ -154,6 +154,19 @@ def test_n_modes_above_the_free_elastic_dof_count_is_refused_naming_the_count():
         modal.solve_modes(model, 55)
 
 
+def test_a_dense_solve_that_does_not_fit_in_memory_falls_back_to_lanczos(monkeypatch):
+    """K, M and LAPACK's copies of the 570-DOF bar take 10 MB; with 5 MB available the default
+    goes to Lanczos (whose factor fits), an explicit dense request stops by name (exit 2)."""
+    from crankmodal.errors import ResourceError
+
+    model = assembly.assemble(bar(1.0, 0.05, 0.04, (18, 1, 4), order=1), STEEL)
+    monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", "0.005")
+    assert modal.solve_modes(model, 6).eigensolver == "lanczos"
+    with pytest.raises(ResourceError, match=r"dense eigensolver needs 0.0104 GB for 570 DOF .* "
+                                            r"modal.eigensolver = 'lanczos'"):
+        modal.solve_modes(model, 6, eigensolver="dense")
+
+
 # --- item 12: a support that holds every node --------------------------------------------------
 
 def test_a_support_box_holding_every_node_says_nothing_is_left_free():

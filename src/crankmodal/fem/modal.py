@@ -546,9 +546,21 @@ DENSE_FRACTION = 0.02
 DENSE_LIMIT_DOF = 6000
 
 
+def dense_bytes(n: int) -> int:
+    """Memory of :func:`dense_pairs` for ``n`` DOF: K, M and LAPACK's copies of both, bytes."""
+    return 4 * 8 * n * n
+
+
 def use_dense(n: int, k: int) -> bool:
-    """Whether ``k`` pairs of an ``n``-DOF pencil are better solved dense than by Lanczos."""
-    return n <= DENSE_MAX_DOF or (k > DENSE_FRACTION * n and n <= DENSE_LIMIT_DOF)
+    """Whether ``k`` pairs of an ``n``-DOF pencil are better solved dense than by Lanczos
+    (and the dense matrices fit in the memory available; else Lanczos, whose factor is smaller
+    and checked on its own)."""
+    from .memory import available_bytes
+
+    if not (n <= DENSE_MAX_DOF or (k > DENSE_FRACTION * n and n <= DENSE_LIMIT_DOF)):
+        return False
+    avail = available_bytes()
+    return avail is None or dense_bytes(n) <= avail
 
 
 def dense_pairs(K, M, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -579,10 +591,16 @@ def dense_pairs(K, M, k: int) -> tuple[np.ndarray, np.ndarray]:
     """
     from scipy.linalg import eigh
 
-    from .solvers import check_memory
+    from ..errors import ResourceError
+    from .memory import available_bytes
 
     n = K.shape[0]
-    check_memory(4 * 8 * n * n, f"modal: the dense eigensolver ({n} DOF)")
+    avail = available_bytes()
+    if avail is not None and dense_bytes(n) > avail:
+        raise ResourceError(
+            f"modal: the dense eigensolver needs {dense_bytes(n) / 1e9:.3g} GB for {n} DOF but "
+            f"{avail / 1e9:.3g} GB are available: use modal.eigensolver = 'lanczos' or 'auto', "
+            f"or a coarser mesh (CRANKMODAL_MEMORY_LIMIT, in GB, sets the available figure)")
     Kd = K.toarray() if sp.issparse(K) else np.array(K, float)
     Md = M.toarray() if sp.issparse(M) else np.array(M, float)
     try:
