@@ -744,7 +744,6 @@ def lanczos_pairs(model: FEModel, K, M, Rq: np.ndarray, deflate: bool, k: int,
         margin = np.where(rigid_mask(f), 1.0, 0.1)
         r = pair_residuals(K @ X, MX, lam_c)
         before, last["r"] = last.get("r"), r
-        last.setdefault("first", float(r.max()))
         if np.all(r <= margin * tol):
             return True
         return (before is not None and len(before) == len(r) and bool(np.all(r <= tol))
@@ -755,13 +754,6 @@ def lanczos_pairs(model: FEModel, K, M, Rq: np.ndarray, deflate: bool, k: int,
         steps = min(room, max(4 * k_run + 40, 60))
         last.clear()  # the floor test compares calls within one run
         out = lanczos(op, M, start(), k_run, LANCZOS_TOL, steps, fresh=start, accept=accept)
-        if (not out.converged and "r" in last and model.material.nu < NU_ILL_CONDITIONED
-                and last["r"].max() < 0.5 * last["first"]):
-            # still falling when the steps ran out: too many modes for one run, not rounding
-            raise NumericalError(
-                f"modal: {k_run} modes did not converge in {out.steps} Lanczos steps (eigen-"
-                f"residual {last['r'].max():.1e} > tol = {tol:.0e}, still falling): ask for "
-                f"fewer modes (modal.n_modes; {k_run} of {n} DOF), or loosen modal.tol")
         r = last.get("r")
         if (not out.converged and r is not None and model.material.nu < NU_ILL_CONDITIONED
                 and len(r) > 1 and r[:len(r) // 2].max() <= tol):
