@@ -165,6 +165,9 @@ def test_n_modes_above_the_free_elastic_dof_count_is_refused_naming_the_count():
     with pytest.raises(SceneError, match=r"modal\.n_modes: 55 elastic modes asked, but the part "
                                          r"has only 54 \(60 free DOF less 6 rigid-body"):
         modal.solve_modes(model, 55)
+    with pytest.raises(SceneError, match=r"modal\.eigensolver: Lanczos cannot find 60 pairs of "
+                                         r"60 DOF; use 'dense'"):
+        modal.solve_modes(model, 54, eigensolver="lanczos")  # was exit 3, 'did not converge'
 
 
 def test_a_dense_solve_that_does_not_fit_in_memory_falls_back_to_lanczos(monkeypatch):

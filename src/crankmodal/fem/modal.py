@@ -863,6 +863,10 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             timings.update(factorize_s=0.0, lanczos_s=0.0, dense_s=time.perf_counter() - t0)
             backend_name, eigensolver, n_solves, solve_time = "dense", "dense", 0, 0.0
         else:
+            if n_rigid_expected + n_modes >= n - 1:  # only when asked for: auto goes dense
+                raise SceneError(f"modal.eigensolver: Lanczos cannot find "
+                                 f"{n_rigid_expected + n_modes} pairs of {n} DOF; use 'dense' "
+                                 f"or 'auto'")
             lam, X, K, M, backend_name, n_solves, solve_time = lanczos_pairs(
                 model, K, M, Rq, deflate, k, shift, backend, tol, timings)
             eigensolver = "lanczos"
