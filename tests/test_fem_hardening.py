@@ -137,8 +137,9 @@ def test_many_free_free_modes_of_a_small_bar_keep_six_rigid_ones_apart():
 
 
 def test_lanczos_and_dense_agree_just_above_the_crossover():
-    model = assembly.assemble(bar(1.0, 0.05, 0.04, (20, 2, 2), order=2), STEEL)  # 3075 DOF
-    assert modal.use_dense(3000, 18) and not modal.use_dense(3075, 18)
+    model = assembly.assemble(bar(1.0, 0.05, 0.04, (8, 2, 2), order=2), STEEL)  # 1275 DOF
+    assert modal.use_dense(1000, 18) and not modal.use_dense(1275, 18)
+    assert modal.use_dense(3075, 62) and not modal.use_dense(6001, 500)  # many modes, to 6000
     lz = modal.solve_modes(model, 12)
     dn = modal.solve_modes(model, 12, eigensolver="dense")
     assert (lz.eigensolver, dn.eigensolver) == ("lanczos", "dense")
@@ -204,7 +205,7 @@ import numpy as np
 from crankmodal.fem import assembly, modal
 from crankmodal.fem.materials import material
 from crankmodal.fem.testparts import bar
-m = assembly.assemble(bar(1.0, 0.05, 0.04, (12, 2, 2), order=2), material("steel"))
+m = assembly.assemble(bar(1.0, 0.05, 0.04, (8, 2, 2), order=2), material("steel"))
 out = {}
 for solver in ("lanczos", "dense"):
     r = modal.solve_modes(m, 12, eigensolver=solver)

@@ -531,15 +531,17 @@ def check_pairs(K, M, lam, X, tol: float = 1e-6, what: str = "modal",
     return res, orth
 
 
-#: Free DOF up to which the pencil is solved dense (:func:`dense_pairs`): LAPACK's ``sygvx``
-#: costs ~0.6 s at 1.3k DOF and 1.3-3 s at 1.9-3.5k on the 2 shared cores, against ~0.15 s for
-#: Lanczos, but it has no convergence to fail: Lanczos stalled or overflowed for 50 modes of
-#: several 350-700-DOF bars (the dense oracle agreeing with the modes where it converged).
-DENSE_MAX_DOF = 3000
+#: Free DOF up to which the pencil is always solved dense (:func:`dense_pairs`): with its
+#: refinement step 0.4 s at 975 DOF, 1.5-3.6 s at 1275, 1-4 s at 1875 on the 2 shared cores,
+#: against 0.05-0.26 s for 12 Lanczos modes; but it has no convergence to fail, and Lanczos
+#: stalled or overflowed for 50 modes of several 350-700-DOF bars. Above it, many modes
+#: (:data:`DENSE_FRACTION`) still go dense.
+DENSE_MAX_DOF = 1000
 
 #: Pairs wanted (rigid included) above this share of the free DOF go dense too, up to
-#: :data:`DENSE_LIMIT_DOF`: 103 modes of a 3465-DOF bar (3 %) did not converge in 452 Lanczos
-#: steps (14 s) where sygvx took 3 s.
+#: :data:`DENSE_LIMIT_DOF`: 103 modes of a 3465-DOF bar (3 %) stalled after 452 Lanczos steps
+#: (14 s) where the dense path took 3-5 s; the lowest share that failed in a scan of 8 bars was
+#: 3 % (60 modes of 1875 DOF, 3.2 %, converged).
 DENSE_FRACTION = 0.02
 
 #: Largest dense problem (K, M and LAPACK's copies: ~1.2 GB; sygvx 23-25 s at 6k DOF).
