@@ -153,3 +153,47 @@ def test_modes_that_swap_order_in_a_variant_are_paired_by_mac_not_by_rank():
         # flat bending scales with thickness: 2.5x (shear makes it a little less)
         assert 2.3 < r["rel_diff"][0] + 1 < 2.5
     assert "† (mode 2)" in st.table_markdown()
+
+
+def test_study_models_run_on_the_sweep_engine_and_resume(tmp_path):
+    """crankmodal study's models are points of the sweep engine (a 2-worker Dask cluster): the
+    same study as one after another in this process (frequencies to 1e-9, the same pairing and
+    MAC), a record per model in models/records.jsonl, and a re-run after losing a record runs
+    only that model."""
+    pytest.importorskip("dask.distributed")
+    from conftest import SCENES
+
+    from crankmodal.report.study_scene import simplification_study
+    from crankmodal.scene import load_scene
+    from crankmodal.sweep.driver import dask_client
+    from crankmodal.sweep.store import RecordStore
+
+    scene = load_scene(SCENES / "seed000_rod_report.toml",
+                       ["report.study_sizes=[0.03]", "report.study_orders=[1]",
+                        "report.study_fidelities=['full', 'simplified']", "report.study_modes=2"])
+    here = simplification_study(scene, tmp_path / "a", figures=False, engine="in-process")
+    lines = []
+    with dask_client(workers=2) as client:
+        dask = simplification_study(scene, tmp_path / "b", figures=False, client=client,
+                                    log=lines.append)
+        assert any(s.startswith("dask: 2 workers") for s in lines)
+        records = tmp_path / "b" / "models" / "records.jsonl"
+        assert len(RecordStore(records).read()) == 2
+        # a kill that lost the last model's record: only it runs again
+        kept = records.read_text().splitlines(keepends=True)[:1]
+        records.write_text("".join(kept))
+        lines.clear()
+        again = simplification_study(scene, tmp_path / "b", figures=False, client=client,
+                                     log=lines.append)
+    assert sorted(here) == sorted(dask) and len(dask["runs"]) == 2
+    for a, b in zip(here["runs"], dask["runs"]):
+        assert (a["fidelity"], a["mesh_size"], a["n_elements"]) == \
+               (b["fidelity"], b["mesh_size"], b["n_elements"])
+        np.testing.assert_allclose(b["frequencies_hz"], a["frequencies_hz"], rtol=1e-9)
+        assert a["mode_of"] == b["mode_of"]
+        np.testing.assert_allclose(b["mac_to_reference"], a["mac_to_reference"], atol=1e-9)
+    assert here["recommended"] == dask["recommended"]
+    assert "study: 1 of 2 models recorded" in "\n".join(lines)
+    assert len(records.read_text().splitlines()) == 2
+    np.testing.assert_allclose([r["frequencies_hz"] for r in again["runs"]],
+                               [r["frequencies_hz"] for r in dask["runs"]], rtol=1e-9)

@@ -66,6 +66,10 @@ def _parser() -> argparse.ArgumentParser:
     scene_args(st)
     st.add_argument("--out", type=Path, help="output folder (default out/<scene name>_study)")
     st.add_argument("--no-figures", action="store_true", help="skip PNG plots")
+    st.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                    help="solve the models on this Dask scheduler instead of a local cluster")
+    st.add_argument("--workers", type=int, metavar="N",
+                    help="worker processes of the local cluster (default: the CPU count)")
 
     sw = sub.add_parser("sweep", parents=[debug],
                         help="run a parameter sweep or search of a scene on Dask (see README)")
@@ -244,7 +248,8 @@ def _main(argv: list[str] | None = None) -> int:
             scene = load_scene(args.scene, args.overrides)
             out_dir = args.out if args.out is not None else _default_out("study", scene.name)
             res = simplification_study(scene, out_dir, figures=not args.no_figures,
-                                       log=lambda m: print(m, file=sys.stderr))
+                                       log=lambda m: print(m, file=sys.stderr),
+                                       scheduler=args.scheduler, workers=args.workers)
             print(res["summary"])
             print(f"study: {out_dir}")
             return 0

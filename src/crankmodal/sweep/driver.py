@@ -204,6 +204,31 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
     return {"ran": len(todo), "skipped": skipped, "failed": failed}
 
 
+def run_tasks_in_process(tasks: list[dict], store: RecordStore, done: dict, log=None) -> dict:
+    """:func:`run_tasks` one after another in this process, without Dask: the same records,
+    store and resumption, for callers that must not start a cluster (a study inside
+    ``crankmodal run``, which may itself be a sweep's point in a daemonic Dask worker) or
+    where Dask is not installed."""
+    from ..progress import bar
+    from .execute import execute_point
+
+    todo = [t for t in tasks if t["key"] not in done]
+    failed = 0
+    with bar(total=len(todo), desc="models", unit="pt") as pb:
+        for task in todo:
+            rec = execute_point(task)
+            rec["dir"] = str(Path(rec["dir"]).relative_to(store.path.parent))
+            store.append(rec)
+            done[rec["key"]] = rec
+            failed += rec["status"] != "ok"
+            pb.update(1)
+            if log and rec["status"] != "ok":
+                pb.clear()
+                log(f"point {rec['point']}: {rec['status']}: {rec['error']}")
+                pb.refresh()
+    return {"ran": len(todo), "skipped": len(tasks) - len(todo), "failed": failed}
+
+
 def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
               workers: int | None = None, retry_failed: bool = False, figures: bool = True,
               log=None) -> dict:

@@ -87,30 +87,53 @@ def collect(results: dict, outputs: list[str]) -> dict:
     return out
 
 
-def _run(base_text, base_path, overrides, out_dir, outputs, figures) -> dict:
-    """The scene run and its record fields (status, exit code, error line, outputs)."""
+def _guarded(fn, outputs) -> dict:
+    """``fn()`` and its record fields (status, exit code, error line); ``fn`` returns the
+    outputs. An error is recorded, never raised: one bad point must not stop a sweep."""
     import warnings
-
-    from ..runner import run
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # a point's model warnings are in its results.json
-            results = run(build_scene(base_text, base_path, overrides), out_dir, figures=figures)
+            out = fn()
     except CrankmodalError as exc:
         return {"status": "error", "exit_code": exc.exit_code, "error": str(exc).splitlines()[0]
                 if str(exc) else type(exc).__name__, "outputs": dict.fromkeys(outputs)}
     except Exception as exc:  # noqa: BLE001 (a bug, not the user's: recorded, the sweep goes on)
         return {"status": "error", "exit_code": 1, "error": f"{type(exc).__name__}: {exc}"
                 .splitlines()[0], "outputs": dict.fromkeys(outputs)}
-    from ..results import to_jsonable
-
-    # the values as results.json has them (lists, not arrays)
-    return {"status": "ok", "exit_code": 0, "error": None,
-            "outputs": collect(to_jsonable(results), outputs)}
+    return {"status": "ok", "exit_code": 0, "error": None, "outputs": out}
 
 
-def _run_in_child(args, timeout_s: float) -> dict:
+def _run(base_text, base_path, overrides, out_dir, outputs, figures) -> dict:
+    """The scene run and its record fields (status, exit code, error line, outputs)."""
+
+    def scene_run():
+        from ..results import to_jsonable
+        from ..runner import run
+
+        results = run(build_scene(base_text, base_path, overrides), out_dir, figures=figures)
+        return collect(to_jsonable(results), outputs)  # as results.json has them (lists)
+
+    return _guarded(scene_run, outputs)
+
+
+def _call(target: str, kwargs: dict, out_dir: str, outputs) -> dict:
+    """A function point: ``target`` ("package.module:function") called as
+    ``function(out_dir=..., **kwargs)``; the dict it returns (JSON-able) is the outputs.
+    Studies that are not one scene run per point (the mesh-simplification study's models) run
+    on the same driver, store and resumption this way."""
+
+    def call():
+        import importlib
+
+        module, _, name = target.partition(":")
+        return getattr(importlib.import_module(module), name)(out_dir=out_dir, **kwargs)
+
+    return _guarded(call, outputs)
+
+
+def _run_in_child(fn, args, timeout_s: float, outputs) -> dict:
     """:func:`_run` in a forked child, killed after ``timeout_s``.
 
     ``os.fork`` itself, not :mod:`multiprocessing`: Dask's worker processes are daemonic, and
@@ -127,7 +150,7 @@ def _run_in_child(args, timeout_s: float) -> dict:
         code = 0
         try:
             os.close(rfd)
-            data = pickle.dumps(_run(*args))
+            data = pickle.dumps(fn(*args))
             with os.fdopen(wfd, "wb") as fh:
                 fh.write(data)
         except BaseException:  # noqa: BLE001 (the child must reach os._exit)
@@ -152,12 +175,12 @@ def _run_in_child(args, timeout_s: float) -> dict:
             os.kill(pid, signal.SIGKILL)
         _, status = os.waitpid(pid, 0)
     if timed_out:
-        return {"status": "timeout", "exit_code": None, "outputs": dict.fromkeys(args[4]),
+        return {"status": "timeout", "exit_code": None, "outputs": dict.fromkeys(outputs),
                 "error": f"the point ran past timeout_s = {timeout_s:g} s"}
     try:
         return pickle.loads(b"".join(chunks))
     except Exception:  # noqa: BLE001 (no complete record came back)
-        return {"status": "error", "exit_code": None, "outputs": dict.fromkeys(args[4]),
+        return {"status": "error", "exit_code": None, "outputs": dict.fromkeys(outputs),
                 "error": f"the point's process died (wait status {status})"}
 
 
@@ -169,7 +192,9 @@ def execute_point(task: dict) -> dict:
     task : dict
         ``index``, ``key``, ``parameters`` ({key: value}), ``overrides`` (list of str),
         ``base_text``, ``base_path``, ``dir`` (the point's output folder), ``outputs``,
-        ``timeout_s`` (or None), ``figures``, ``round`` (search round).
+        ``timeout_s`` (or None), ``figures``, ``round`` (search round). A function point has
+        ``call`` ("module:function") and ``kwargs`` instead of the scene's keys (see
+        :func:`_call`).
 
     Returns
     -------
@@ -179,12 +204,15 @@ def execute_point(task: dict) -> dict:
         ``error`` (one line or None), ``outputs``, ``wall_time_s``, ``dir``, ``round``.
     """
     t0 = time.perf_counter()
-    args = (task["base_text"], task["base_path"], task["overrides"], task["dir"],
-            task["outputs"], task["figures"])
-    if task.get("timeout_s"):
-        res = _run_in_child(args, task["timeout_s"])
+    if task.get("call"):
+        fn, args = _call, (task["call"], task["kwargs"], task["dir"], task["outputs"])
     else:
-        res = _run(*args)
+        fn, args = _run, (task["base_text"], task["base_path"], task["overrides"], task["dir"],
+                          task["outputs"], task["figures"])
+    if task.get("timeout_s"):
+        res = _run_in_child(fn, args, task["timeout_s"], task["outputs"])
+    else:
+        res = fn(*args)
     return {"point": task["index"], "key": task["key"], "round": task.get("round", 0),
             "parameters": task["parameters"], **res,
             "wall_time_s": time.perf_counter() - t0, "dir": task["dir"]}
