@@ -1,8 +1,11 @@
-"""Shared fixtures: the repository paths and a helper that runs the CLI in a subprocess."""
+"""Shared fixtures: the repository paths and helpers that run the CLI (subprocess, in process)."""
 
+import contextlib
+import io
 import os
 import subprocess
 import sys
+import warnings as _warnings
 from pathlib import Path
 
 import pytest
@@ -22,6 +25,25 @@ def run_cli(*args, cwd=None, timeout=600, warnings="ignore"):
         cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout,
         check=False,  # callers assert on the exit code (0, 2 or 3) themselves
     )
+
+
+def run_in_process(*argv) -> tuple[int, str]:
+    """``crankmodal ARGV`` in this process (so monkeypatches apply): (exit status, stderr).
+
+    Warnings are ignored as :func:`run_cli` does, so stderr holds only the error path; an
+    exception escaping ``main`` is raised (the defect a caller looks for)."""
+    from crankmodal import cli
+
+    err = io.StringIO()
+    show = _warnings.showwarning
+    try:
+        with _warnings.catch_warnings(), contextlib.redirect_stderr(err), \
+                contextlib.redirect_stdout(io.StringIO()):
+            _warnings.simplefilter("ignore")
+            status = cli.main([str(a) for a in argv])
+    finally:
+        _warnings.showwarning = show  # main() installs its own formatter
+    return status, err.getvalue()
 
 
 @pytest.fixture

@@ -18,21 +18,17 @@ truncated file.
 
 from __future__ import annotations
 
-import contextlib
 import errno
-import io
 import json
 import math
 import os
 import random
 import re
-import warnings
 
 import numpy as np
 import pytest
-from conftest import SCENES
+from conftest import SCENES, run_in_process
 
-from crankmodal import cli
 from crankmodal.resources import load_machine
 from crankmodal.scene import load_scene
 
@@ -118,20 +114,6 @@ def display_key(dotted: str) -> str:
     return text
 
 
-def run_in_process(*argv) -> tuple[int, str]:
-    """``crankmodal ARGV`` in this process: (exit status, stderr); an escaping exception is raised.
-
-    Warnings are ignored as :func:`conftest.run_cli` does, so stderr holds only the error path."""
-    err = io.StringIO()
-    show = warnings.showwarning
-    try:
-        with warnings.catch_warnings(), contextlib.redirect_stderr(err), \
-                contextlib.redirect_stdout(io.StringIO()):
-            warnings.simplefilter("ignore")
-            status = cli.main([str(a) for a in argv])
-    finally:
-        warnings.showwarning = show  # main() installs its own formatter
-    return status, err.getvalue()
 
 
 def error_problem(status, stderr, key, value, allowed=(0, 2)) -> str | None:

@@ -10,18 +10,15 @@
 
 from __future__ import annotations
 
-import contextlib
 import errno
-import io
 import os
-import warnings
 
 import numpy as np
 import pytest
 from conftest import SCENES
 from conftest import run_cli as run_subprocess
+from conftest import run_in_process as run_cli
 
-from crankmodal import cli
 from crankmodal.errors import OutputError
 from crankmodal.results import atomic_path, savefig_atomic, write_atomic
 
@@ -29,18 +26,6 @@ TORSION = SCENES / "torsion_chain.toml"      # ~0.3 s, no gmsh
 MECHANISM = SCENES / "four_star_mechanism.toml"  # ~2 s, writes an .npz and figures
 
 
-def run_cli(*argv) -> tuple[int, str]:
-    """``crankmodal ARGV`` in this process (so monkeypatches apply): (status, stderr)."""
-    err = io.StringIO()
-    show = warnings.showwarning
-    try:
-        with warnings.catch_warnings(), contextlib.redirect_stderr(err), \
-                contextlib.redirect_stdout(io.StringIO()):
-            warnings.simplefilter("ignore")
-            status = cli.main([str(a) for a in argv])
-    finally:
-        warnings.showwarning = show
-    return status, err.getvalue()
 
 
 def error_line(status, stderr, *fragments, code=2) -> str:
