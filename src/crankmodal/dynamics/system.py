@@ -66,6 +66,8 @@ class Multibody:
         self.m = j
         self._kkt = np.zeros((self.n + self.m, self.n + self.m))
         self._rigid = all(hasattr(b, "inertia") for b in self.bodies)
+        # bodies with elastic coordinates (FlexibleBody): internal forces and strain energy
+        self._elastic = [b for b in self.bodies if hasattr(b, "internal_forces")]
         if self._rigid:
             self._kkt[: self.n, : self.n] = self.mass_matrix(np.zeros(self.n))
         self.nfev = 0
@@ -183,6 +185,14 @@ class Multibody:
             pe += b.potential_energy(q[s], self.gravity)
         return ke, pe
 
+    def strain_energy(self, q):
+        """Elastic strain energy of the flexible bodies, J."""
+        return sum(b.strain_energy(q[self.slices[id(b)]]) for b in self._elastic)
+
+    def damping_power(self, qd):
+        """Power dissipated by the flexible bodies' modal damping, W."""
+        return sum(b.damping_power(qd[self.slices[id(b)]]) for b in self._elastic)
+
     def solve(self, t, q, qd):
         """Accelerations, multipliers and per-element diagnostics at one state."""
         n = self.n
@@ -191,6 +201,9 @@ class Multibody:
         for b in self.bodies:
             s = self.slices[id(b)]
             Q[s] += b.gravity_force(q[s], self.gravity) + b.velocity_forces(q[s], qd[s])
+        for b in self._elastic:
+            s = self.slices[id(b)]
+            Q[s] -= b.internal_forces(q[s], qd[s])
         contacts = [cj.forces(self, t, q, qd, Q) for cj in self.clearances]
         p_loads = sum(ld.forces(self, t, q, qd, Q) for ld in self.loads)
         phi, Cq, nu, gamma = self.constraint_terms(t, q, qd)

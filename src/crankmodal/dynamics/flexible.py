@@ -1,0 +1,293 @@
+"""A planar floating-frame flexible body built from a ``crankmodal-flexbody`` .npz.
+
+Coordinates ``q = (x, y, θ, ξ_1 … ξ_k)``: the position (m) and angle (rad) of the body frame and
+the amplitudes of k elastic orthonormal modes (unit 3D modal mass, so ``ξ`` is in m·kg^½).
+
+Reference conditions: mean axes (Tisserand) at the centre of mass. The body frame's origin is
+the undeformed part's centre of mass, its axes are the part's x–y axes (the plane of motion:
+"the rod lies in the x-y plane with the big-end bore on the z axis"). The orthonormal elastic
+modes of the .npz are mass-orthogonal to its six rigid ones, so ``I3 = ∫ρΦ = 0`` and
+``I4 = ∫ρ x̃Φ = 0``: the elastic deformation moves neither the centre of mass nor the mean
+orientation, the frame follows the mean motion of the body and the translation–elastic and the
+linear rotation–elastic inertia couplings vanish exactly. This is seed 000's choice; it needs no
+extra constraint and keeps the rigid part of ``M`` constant.
+
+Plane restriction: a material point moves as ``r = R + A(θ)(u₀ + Φ_xy ξ)``, with ``Φ_xy`` the
+x and y rows of the mode shapes; the z displacement of the modes and their rotations about x
+and y are dropped. From the invariants (``[2, …]`` is the z component)::
+
+    G  = I9[2, 2]            ∫ρ Φ_xyᵀ Φ_xy           in-plane modal mass (k, k)
+    b  = I8[2, 2]            ∫ρ u₀·φ_a (in-plane)     (k,)
+    S  = I5[2]               S[a, b] = ∫ρ (φ_a × φ_b)_z, antisymmetric (k, k)
+    J₀ = inertia[2, 2]       polar moment about the centre of mass, kg m²
+
+    M(ξ) = [[m I₂, 0,                 0    ],
+            [0,    J₀ + 2bᵀξ + ξᵀGξ,  ξᵀS  ],
+            [0,    Sᵀξ,               G    ]]
+
+Only modes whose in-plane mass share ``G_aa`` is at least ``min_in_plane`` are offered (an
+out-of-plane bending or a torsion mode would keep its 3D stiffness with almost no planar mass);
+:meth:`FlexibleBody.left_out` reports, per kept mode, the modal mass and interface motion the
+plane drops, and which stored modes were not offered.
+
+Internal forces: ``K ξ + C ξ̇`` with ``K = diag(ω²)`` and ``C = diag(2 ζ_a ω_a)`` (ζ a ratio per
+mode, default :data:`DEFAULT_DAMPING`, of the unit 3D modal mass); strain energy ``½ ξᵀKξ``.
+Interfaces are the .npz's interface nodes, named as their regions; a frame's pose is that of the
+interface node: position ``R + A(s₀ + D ξ)``, angle ``θ + r_zᵀ ξ`` (``D`` the x, y translation
+rows and ``r_z`` the z rotation row of ``interface_map``; the out-of-plane rows are dropped).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+
+DEFAULT_DAMPING = 0.02
+"""Modal damping ratio of every kept mode when none is given (2 %, a common value for steel
+parts bolted into an assembly; not measured here)."""
+
+MIN_IN_PLANE = 0.5
+_OMEGA = np.array([[0.0, -1.0], [1.0, 0.0]])
+
+
+class FlexibleBody:
+    """A planar floating-frame body with modal coordinates (SI units).
+
+    Parameters
+    ----------
+    name : str
+    mass : float
+        kg.
+    j0 : float
+        Polar moment of inertia about the centre of mass, kg m².
+    centre : (2,) array
+        Centre of mass in part coordinates, m.
+    frequencies_hz : (k,) array
+        Of the kept elastic modes.
+    G, b, S : arrays (k, k), (k,), (k, k)
+        In-plane invariants (see the module docstring).
+    interfaces : dict str -> (centre (3,), map (6, k))
+        Interface node position (part coordinates, m) and its rows of ``interface_map``.
+    damping_ratio : float or (k,) array
+    z : float
+        Axial position of the body's plane, m (3D moments only, as :class:`RigidBody`).
+    info : dict
+        Provenance and what the plane leaves out (:meth:`left_out`).
+    """
+
+    def __init__(self, name, mass, j0, centre, frequencies_hz, G, b, S, interfaces,
+                 damping_ratio=DEFAULT_DAMPING, z=0.0, info=None):
+        self.name = name
+        self.mass = float(mass)
+        self.j0 = float(j0)
+        self.centre = np.asarray(centre, float)[:2]
+        self.frequencies_hz = np.asarray(frequencies_hz, float)
+        k = len(self.frequencies_hz)
+        self.n_modes = k
+        self.ndof = 3 + k
+        w = 2 * np.pi * self.frequencies_hz
+        self.zeta = np.broadcast_to(np.asarray(damping_ratio, float), (k,)).copy()
+        self.K = w ** 2
+        self.C = 2.0 * self.zeta * w
+        self.G = np.asarray(G, float).reshape(k, k)
+        self.b = np.asarray(b, float).reshape(k)
+        self.S = np.asarray(S, float).reshape(k, k)
+        self.frames = {}
+        for nm, (c, mp) in interfaces.items():
+            mp = np.asarray(mp, float).reshape(6, k)
+            # s0: the interface node relative to the centre of mass; D: its in-plane translation
+            # per ξ; rz: its rotation about z per ξ
+            self.frames[nm] = (np.asarray(c, float)[:2] - self.centre, mp[:2].copy(), mp[5].copy())
+        self.z = float(z)
+        self.info = dict(info or {})
+
+    # ----------------------------------------------------------------- inertia
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """``M(ξ)``, shape (3 + k, 3 + k), kg, kg m, kg m²."""
+        xi = q[3:]
+        M = np.zeros((self.ndof, self.ndof))
+        M[0, 0] = M[1, 1] = self.mass
+        M[2, 2] = self.j0 + 2.0 * self.b @ xi + xi @ self.G @ xi
+        h = self.S.T @ xi
+        M[2, 3:] = h
+        M[3:, 2] = h
+        M[3:, 3:] = self.G
+        return M
+
+    def velocity_forces(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """Quadratic velocity forces ``∂T/∂q − Ṁ q̇`` (centrifugal and Coriolis), N, N m."""
+        xi, w, xid = q[3:], qd[2], qd[3:]
+        c = self.b + self.G @ xi
+        out = np.zeros(self.ndof)
+        out[2] = -2.0 * w * (c @ xid)
+        out[3:] = w * w * c + 2.0 * w * (self.S @ xid)
+        return out
+
+    def internal_forces(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """Elastic and modal damping forces ``[0, 0, 0, Kξ + Cξ̇]`` (moved to the left side)."""
+        out = np.zeros(self.ndof)
+        out[3:] = self.K * q[3:] + self.C * qd[3:]
+        return out
+
+    def damping_power(self, qd: np.ndarray) -> float:
+        """Power dissipated by modal damping, W (≥ 0)."""
+        return float(self.C @ (qd[3:] ** 2))
+
+    def gravity_force(self, q: np.ndarray, g: np.ndarray) -> np.ndarray:
+        """Generalised weight: the centre of mass is the frame origin (``I3 = 0``)."""
+        out = np.zeros(self.ndof)
+        out[0], out[1] = self.mass * g[0], self.mass * g[1]
+        return out
+
+    def potential_energy(self, q: np.ndarray, g: np.ndarray) -> float:
+        """Gravitational potential energy, J (zero at the origin)."""
+        return -self.mass * float(g[0] * q[0] + g[1] * q[1])
+
+    def strain_energy(self, q: np.ndarray) -> float:
+        """``½ ξᵀKξ``, J."""
+        return 0.5 * float(self.K @ (q[3:] ** 2))
+
+    def kinetic_energy(self, q: np.ndarray, qd: np.ndarray) -> float:
+        """J."""
+        return 0.5 * float(qd @ self.mass_matrix(q) @ qd)
+
+    # ----------------------------------------------------------------- interface frames
+    def _local(self, q, frame):
+        s0, D, rz = self.frames[frame]
+        c, sn = np.cos(q[2]), np.sin(q[2])
+        A = np.array([[c, -sn], [sn, c]])
+        return A, s0 + D @ q[3:], D, rz
+
+    def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """Pose ``(x, y, phi)`` of an interface node in the global plane, m and rad."""
+        A, s, _, rz = self._local(q, frame)
+        p = q[:2] + A @ s
+        return np.array([p[0], p[1], q[2] + rz @ q[3:]])
+
+    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
+        """d(pose)/dq, shape (3, 3 + k)."""
+        A, s, D, rz = self._local(q, frame)
+        J = np.zeros((3, self.ndof))
+        J[0, 0] = J[1, 1] = J[2, 2] = 1.0
+        As = A @ s
+        J[0, 2], J[1, 2] = -As[1], As[0]
+        J[:2, 3:] = A @ D
+        J[2, 3:] = rz
+        return J
+
+    def frame_bias(self, q: np.ndarray, qd: np.ndarray, frame: str) -> np.ndarray:
+        """``Jdot qdot``: centripetal ``−θ̇² A s`` and Coriolis ``2 θ̇ Ω A D ξ̇``, m/s²."""
+        A, s, D, _ = self._local(q, frame)
+        w = qd[2]
+        a = -w * w * (A @ s) + 2.0 * w * (_OMEGA @ (A @ (D @ qd[3:])))
+        return np.array([a[0], a[1], 0.0])
+
+    def left_out(self) -> dict:
+        """What the plane drops: per kept mode the out-of-plane share of its modal mass
+        (``1 − G_aa``) and of its interface translations and rotations (squared norms), and
+        the stored elastic modes not offered (frequency, in-plane share)."""
+        return self.info.get("left_out", {})
+
+
+def _fail(path, text, cls=SceneError):
+    raise cls(f"{path}: {text}")
+
+
+def load_flexible_body(path, name: str, n_modes: int | None = None,
+                       cutoff_hz: float | None = None,
+                       damping_ratio=DEFAULT_DAMPING, interfaces=None,
+                       min_in_plane: float = MIN_IN_PLANE, z: float = 0.0) -> FlexibleBody:
+    """Read a ``crankmodal-flexbody`` .npz as a planar :class:`FlexibleBody`.
+
+    Parameters
+    ----------
+    path : str or Path
+    name : str
+        Body name.
+    n_modes : int, optional
+        In-plane elastic modes to keep, lowest first (0: frozen, a rigid body).
+    cutoff_hz : float, optional
+        Keep the in-plane elastic modes up to this frequency, Hz. Neither given: all of them.
+    damping_ratio : float or sequence
+        Modal damping ratio per kept mode (≥ 0).
+    interfaces : sequence of str, optional
+        Interface names the caller needs (each must be in the file).
+    min_in_plane : float
+        Smallest in-plane share of a mode's modal mass for it to be offered.
+    z : float
+        Axial position of the body's plane, m.
+
+    Raises
+    ------
+    InputFileError
+        Not a readable crankmodal-flexbody file of version 1.
+    SceneError
+        More modes than stored, both or a bad selection, negative damping, a missing interface.
+    """
+    from ..reduction.io import load_flexbody
+
+    path = Path(path)
+    fb = load_flexbody(path)  # InputFileError: missing, unreadable, other format or version
+    el = ~np.asarray(fb.rigid, bool)
+    f_el = fb.frequencies_hz[el]
+    inv = fb.invariants
+    G_all = np.asarray(inv["I9"])[2, 2]
+    share = np.diag(G_all)
+    offered = np.flatnonzero(share >= min_in_plane)
+    if n_modes is not None and cutoff_hz is not None:
+        _fail(path, "give either n_modes or cutoff_hz, not both")
+    if n_modes is not None:
+        if int(n_modes) != n_modes or n_modes < 0:
+            _fail(path, f"n_modes = {n_modes!r}: must be an integer >= 0")
+        if n_modes > len(offered):
+            _fail(path, f"n_modes = {n_modes}: the file stores {len(offered)} in-plane elastic "
+                        f"modes (of {int(el.sum())} elastic, in-plane share >= {min_in_plane})")
+        keep = offered[:int(n_modes)]
+    elif cutoff_hz is not None:
+        if not cutoff_hz > 0:
+            _fail(path, f"cutoff_hz = {cutoff_hz!r}: must be > 0 Hz")
+        keep = offered[f_el[offered] <= cutoff_hz]
+    else:
+        keep = offered
+    k = len(keep)
+    zeta = np.asarray(damping_ratio, float)
+    if zeta.ndim > 1 or (zeta.ndim == 1 and len(zeta) != k):
+        _fail(path, f"damping_ratio: give one ratio or {k} (one per kept mode), got {zeta.size}")
+    if not np.all(np.isfinite(zeta)) or np.any(zeta < 0):
+        _fail(path, f"damping_ratio = {damping_ratio!r}: must be >= 0")
+    names = list(fb.interface_names)
+    for itf in interfaces or ():
+        if itf not in names:
+            _fail(path, f"no interface {itf!r}; interfaces: {', '.join(names) or 'none'}")
+    cols = np.flatnonzero(el)[keep]  # columns of the elastic modes among all n
+    imap = np.asarray(fb.interface_map)[:, :, cols]
+    G = G_all[np.ix_(keep, keep)]
+    b = np.asarray(inv["I8"])[2, 2][keep]
+    S = np.asarray(inv["I5"])[2][np.ix_(keep, keep)]
+    tr = np.sum(imap[:, :3] ** 2, axis=(0, 1))
+    rot = np.sum(imap[:, 3:] ** 2, axis=(0, 1))
+    tiny = 1e-300
+    left = {
+        "kept_hz": f_el[keep].tolist(),
+        "out_of_plane_mass_share": (1.0 - np.diag(G)).tolist(),
+        "out_of_plane_interface_translation_share":
+            (np.sum(imap[:, 2] ** 2, axis=0) / np.maximum(tr, tiny)).tolist(),
+        "out_of_plane_interface_rotation_share":
+            (np.sum(imap[:, 3:5] ** 2, axis=(0, 1)) / np.maximum(rot, tiny)).tolist(),
+        "not_offered": [{"hz": float(f_el[i]), "in_plane_share": float(share[i])}
+                        for i in range(len(f_el)) if share[i] < min_in_plane],
+        "translation_coupling_I3": float(np.abs(np.asarray(inv["I3"])).max(initial=0.0)),
+        "rotation_coupling_I4z": float(np.abs(np.asarray(inv["I4"])[2]).max(initial=0.0)),
+    }
+    return FlexibleBody(
+        name=name, mass=fb.mass_kg, j0=float(np.asarray(fb.inertia)[2, 2]),
+        centre=fb.centre_of_mass, frequencies_hz=f_el[keep], G=G, b=b, S=S,
+        interfaces={n: (fb.interface_centres[i], imap[i]) for i, n in enumerate(names)},
+        damping_ratio=zeta if zeta.ndim else float(zeta), z=z,
+        info={"file": str(path), "part": fb.name, "left_out": left})
+
+
+__all__ = ["DEFAULT_DAMPING", "FlexibleBody", "load_flexible_body"]
