@@ -65,7 +65,9 @@ class Multibody:
             j += c.n_eq
         self.m = j
         self._kkt = np.zeros((self.n + self.m, self.n + self.m))
-        self._rigid = all(hasattr(b, "inertia") for b in self.bodies)
+        # constant mass matrix only for rigid bodies (a flexible one has M(q)): decided by type,
+        # not by duck-typing an attribute a flexible body might also carry
+        self._rigid = all(isinstance(b, RigidBody) for b in self.bodies)
         # bodies with elastic coordinates (FlexibleBody): internal forces and strain energy
         self._elastic = [b for b in self.bodies if hasattr(b, "internal_forces")]
         if self._rigid:
