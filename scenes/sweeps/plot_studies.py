@@ -127,7 +127,7 @@ def fig27(folder: Path) -> None:
     plt.close(fig)
 
 
-def surface(ax, fig, xs, ys, z, label, xlabel, ylabel):
+def surface(ax, fig, xs, ys, z, label, xlabel, ylabel, fmt="{:.3g}"):
     ux, uy = np.unique(xs), np.unique(ys)
     grid = np.full((len(uy), len(ux)), np.nan)
     for x, y, v in zip(xs, ys, z):
@@ -139,7 +139,7 @@ def surface(ax, fig, xs, ys, z, label, xlabel, ylabel):
     for i, y in enumerate(uy):
         for j, x in enumerate(ux):
             if np.isfinite(grid[i, j]):
-                ax.text(x, y, f"{grid[i, j]:.3g}", ha="center", va="center", fontsize=7,
+                ax.text(x, y, fmt.format(grid[i, j]), ha="center", va="center", fontsize=7,
                         color="w" if grid[i, j] < np.nanmean(grid) else "k")
     fig.colorbar(pc, ax=ax, label=label)
     ax.set_xlabel(xlabel)
@@ -159,7 +159,7 @@ def clearance_speed(folder: Path) -> None:
     g1 = surface(axes[0], fig, c, n, mb, "main-bearing force, per-rev peak (mean), kN",
                  "big end 1 radial clearance, mm", "speed, rpm")
     g2 = surface(axes[1], fig, c, n, pa, "piston 1 acceleration, per-rev peak (mean), m/s²",
-                 "big end 1 radial clearance, mm", "speed, rpm")
+                 "big end 1 radial clearance, mm", "speed, rpm", fmt="{:.0f}")
     fig.suptitle("Seed 000 Figs. 24/25 as surfaces: four-star, clearance in big end 1 "
                  "(0.5 s, 0.1 s ramp)", fontsize=10)
     fig.tight_layout()
