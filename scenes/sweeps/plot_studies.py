@@ -127,7 +127,7 @@ def fig27(folder: Path) -> None:
     plt.close(fig)
 
 
-def surface(ax, fig, xs, ys, z, label, xlabel, ylabel, fmt="{:.3g}"):
+def surface(ax, fig, xs, ys, z, label, xlabel, ylabel, fmt="{:.3g}", vmin=None, vmax=None):
     ux, uy = np.unique(xs), np.unique(ys)
     grid = np.full((len(uy), len(ux)), np.nan)
     for x, y, v in zip(xs, ys, z):
@@ -135,12 +135,13 @@ def surface(ax, fig, xs, ys, z, label, xlabel, ylabel, fmt="{:.3g}"):
     def edges(u):
         m = 0.5 * (u[1:] + u[:-1])
         return np.concatenate([[2 * u[0] - m[0]], m, [2 * u[-1] - m[-1]]])
-    pc = ax.pcolormesh(edges(ux), edges(uy), grid, shading="flat", cmap="viridis")
+    pc = ax.pcolormesh(edges(ux), edges(uy), grid, shading="flat", cmap="viridis", vmin=vmin,
+                       vmax=vmax)
     for i, y in enumerate(uy):
         for j, x in enumerate(ux):
             if np.isfinite(grid[i, j]):
                 ax.text(x, y, fmt.format(grid[i, j]), ha="center", va="center", fontsize=7,
-                        color="w" if grid[i, j] < np.nanmean(grid) else "k")
+                        color="w" if grid[i, j] < 0.5 * (np.nanmin(grid) + np.nanmax(grid)) else "k")
     fig.colorbar(pc, ax=ax, label=label)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
@@ -186,11 +187,13 @@ def regime(folder: Path) -> None:
         sel = coarse & np.isclose(pz, p)
         surface(ax, fig, wear[sel], speed[sel], v[sel],
                 "largest big-end impact velocity per rev (mean), m/s",
-                "worn big end: major radial clearance, mm", "speed, rpm")
+                "worn big end: major radial clearance, mm", "speed, rpm", vmin=0.0,
+                vmax=float(np.nanmax(v[coarse])))
         ax.set_title(f"peak cylinder pressure {p:g} MPa", fontsize=9)
     b = int(np.nanargmax(v))
-    for ax in axes:
-        ax.plot(wear[b], speed[b], "r*", ms=14, mec="k")
+    ps = sorted(set(np.round(pz[coarse], 3)))
+    axes[int(np.argmin([abs(p - pz[b]) for p in ps]))].plot(wear[b], speed[b], "r*", ms=14,
+                                                             mec="k")
     fig.suptitle(f"Seed 003 diagnostic regime: best {v[b]:.3g} m/s at {speed[b]:.0f} rpm, "
                  f"{pz[b]:.2f} MPa, {wear[b]:.3f} mm (red star; search points not on the grid)",
                  fontsize=10)
