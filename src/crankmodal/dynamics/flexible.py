@@ -79,7 +79,8 @@ class FlexibleBody:
     """
 
     def __init__(self, name, mass, j0, centre, frequencies_hz, G, b, S, interfaces,
-                 damping_ratio=DEFAULT_DAMPING, z=0.0, info=None):
+                 damping_ratio=DEFAULT_DAMPING, z=0.0, info=None, c=None, n_tilt=0,
+                 orientation=0.0):
         self.name = name
         self.mass = float(mass)
         self.j0 = float(j0)
@@ -87,6 +88,8 @@ class FlexibleBody:
         self.frequencies_hz = np.asarray(frequencies_hz, float)
         k = len(self.frequencies_hz)
         self.n_modes = k
+        self.n_tilt = int(n_tilt)
+        self.n_elastic = k - self.n_tilt
         self.ndof = 3 + k
         w = 2 * np.pi * self.frequencies_hz
         self.zeta = np.broadcast_to(np.asarray(damping_ratio, float), (k,)).copy()
@@ -95,14 +98,27 @@ class FlexibleBody:
         self.G = np.asarray(G, float).reshape(k, k)
         self.b = np.asarray(b, float).reshape(k)
         self.S = np.asarray(S, float).reshape(k, k)
+        self.c = np.zeros(k) if c is None else np.asarray(c, float).reshape(k)
+        self.orientation = float(orientation)
+        co, so = np.cos(-self.orientation), np.sin(-self.orientation)
+        R = np.array([[co, -so], [so, co]])  # part x-y axes -> body axes
         self.frames = {}
-        for nm, (c, mp) in interfaces.items():
+        for nm, (cen, mp) in interfaces.items():
             mp = np.asarray(mp, float).reshape(6, k)
             # s0: the interface node relative to the centre of mass; D: its in-plane translation
-            # per ξ; rz: its rotation about z per ξ
-            self.frames[nm] = (np.asarray(c, float)[:2] - self.centre, mp[:2].copy(), mp[5].copy())
+            # per ξ; rz: its rotation about z per ξ (all in body axes)
+            self.frames[nm] = (R @ (np.asarray(cen, float)[:2] - self.centre), R @ mp[:2],
+                               mp[5].copy())
         self.z = float(z)
         self.info = dict(info or {})
+
+    def alias(self, name: str, frame: str) -> None:
+        """Name interface ``frame`` also ``name`` (a mechanism's frame names: ``main``, ``pin``…)."""
+        self.frames[name] = self.frames[frame]
+
+    def elastic(self, q: np.ndarray) -> np.ndarray:
+        """The elastic modal coordinates of ``q`` (without the tilt coordinates), m kg^½."""
+        return q[3:3 + self.n_elastic]
 
     # ----------------------------------------------------------------- inertia
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
@@ -111,7 +127,7 @@ class FlexibleBody:
         M = np.zeros((self.ndof, self.ndof))
         M[0, 0] = M[1, 1] = self.mass
         M[2, 2] = self.j0 + 2.0 * self.b @ xi + xi @ self.G @ xi
-        h = self.S.T @ xi
+        h = self.c + self.S.T @ xi
         M[2, 3:] = h
         M[3:, 2] = h
         M[3:, 3:] = self.G
@@ -199,7 +215,8 @@ def _fail(path, text, cls=SceneError):
 def load_flexible_body(path, name: str, n_modes: int | None = None,
                        cutoff_hz: float | None = None,
                        damping_ratio=DEFAULT_DAMPING, interfaces=None,
-                       min_in_plane: float = MIN_IN_PLANE, z: float = 0.0) -> FlexibleBody:
+                       min_in_plane: float = MIN_IN_PLANE, z: float = 0.0, tilt: bool = False,
+                       orientation: float = 0.0) -> FlexibleBody:
     """Read a ``crankmodal-flexbody`` .npz as a planar :class:`FlexibleBody`.
 
     Parameters
@@ -219,6 +236,14 @@ def load_flexible_body(path, name: str, n_modes: int | None = None,
         Smallest in-plane share of a mode's modal mass for it to be offered.
     z : float
         Axial position of the body's plane, m.
+    tilt : bool
+        Append the two small rigid tilts about the part's x and y axes through the centre of
+        mass as coordinates without stiffness (see :func:`tilt_terms`): a shaft held in the
+        plane at two or more journals at different z needs them, or the journals would also
+        hold its mean axis straight.
+    orientation : float
+        Angle of the body frame's x axis from the part's x axis, rad (e.g. the crank's pin
+        direction, so that the frame angle is the crank angle).
 
     Raises
     ------
@@ -254,6 +279,7 @@ def load_flexible_body(path, name: str, n_modes: int | None = None,
         keep = offered
     k = len(keep)
     zeta = np.asarray(damping_ratio, float)
+    k = len(keep)
     if zeta.ndim > 1 or (zeta.ndim == 1 and len(zeta) != k):
         _fail(path, f"damping_ratio: give one ratio or {k} (one per kept mode), got {zeta.size}")
     if not np.all(np.isfinite(zeta)) or np.any(zeta < 0):
@@ -282,12 +308,68 @@ def load_flexible_body(path, name: str, n_modes: int | None = None,
         "translation_coupling_I3": float(np.abs(np.asarray(inv["I3"])).max(initial=0.0)),
         "rotation_coupling_I4z": float(np.abs(np.asarray(inv["I4"])[2]).max(initial=0.0)),
     }
+    c = np.asarray(inv["I4"])[2][keep]  # ∫ρ (u0 × φ_a)_z: 0 for mean axes, kept as stored
+    freq = f_el[keep]
+    centres = np.asarray(fb.interface_centres, float)
+    zeta = np.broadcast_to(zeta, (k,)) if zeta.ndim else np.full(k, float(zeta))
+    n_tilt = 0
+    if tilt:
+        I8 = np.asarray(inv["I8"])[:, :, keep]
+        G, b, S, c, imap = tilt_terms(G, b, S, c, imap, I8, np.asarray(fb.inertia, float),
+                                      np.asarray(fb.centre_of_mass, float), centres)
+        freq = np.concatenate([freq, [0.0, 0.0]])
+        zeta = np.concatenate([zeta, [0.0, 0.0]])
+        n_tilt = 2
     return FlexibleBody(
         name=name, mass=fb.mass_kg, j0=float(np.asarray(fb.inertia)[2, 2]),
-        centre=fb.centre_of_mass, frequencies_hz=f_el[keep], G=G, b=b, S=S,
-        interfaces={n: (fb.interface_centres[i], imap[i]) for i, n in enumerate(names)},
-        damping_ratio=zeta if zeta.ndim else float(zeta), z=z,
-        info={"file": str(path), "part": fb.name, "left_out": left})
+        centre=fb.centre_of_mass, frequencies_hz=freq, G=G, b=b, S=S, c=c,
+        interfaces={n: (centres[i], imap[i]) for i, n in enumerate(names)},
+        damping_ratio=zeta, z=z, n_tilt=n_tilt, orientation=orientation,
+        info={"file": str(path), "part": fb.name, "left_out": left,
+              "interface_centres": {n: centres[i].tolist() for i, n in enumerate(names)}})
 
 
-__all__ = ["DEFAULT_DAMPING", "FlexibleBody", "load_flexible_body"]
+def tilt_terms(G, b, S, c, imap, I8, inertia, com, centres):
+    """Planar invariants and interface rows extended by the two rigid tilts.
+
+    A tilt by a small angle α about the part's x axis through the centre of mass moves a point
+    in the plane by ``(0, −α z̄)``, one about y by ``(α z̄, 0)`` (``z̄ = z − z_c``; their z
+    displacements are out of the plane and dropped like the modes'). They are rigid motions:
+    no stiffness, no damping. Their planar invariants follow from the inertia tensor ``I``
+    about the centre of mass and ``I8`` of the elastic modes (:mod:`crankmodal.reduction.flexbody`;
+    ``∫ρ z φ_a,i = −I8[i, 2, a]``, the mean-axis condition ``∫ρ φ = 0`` making the origin
+    irrelevant)::
+
+        G[tx, tx] = G[ty, ty] = Z = ∫ρ z̄² = (I_xx + I_yy − I_zz) / 2,   G[tx, a] = I8[1, 2, a],
+        G[ty, a] = −I8[0, 2, a];   b = (I_yz, −I_xz) (tensor entries);   c = (I_xz, I_yz);
+        S[tx, ty] = Z,  S[tx, a] = −I8[0, 2, a],  S[ty, a] = −I8[1, 2, a]  (S antisymmetric).
+
+    Returns ``G, b, S, c, imap`` with the two tilt columns appended (in that order: x, y).
+    """
+    k = len(b)
+    Z = 0.5 * (inertia[0, 0] + inertia[1, 1] - inertia[2, 2])
+    gx, gy = I8[1, 2], -I8[0, 2]
+    G2 = np.zeros((k + 2, k + 2))
+    G2[:k, :k] = G
+    G2[k, :k] = G2[:k, k] = gx
+    G2[k + 1, :k] = G2[:k, k + 1] = gy
+    G2[k, k] = G2[k + 1, k + 1] = Z
+    S2 = np.zeros((k + 2, k + 2))
+    S2[:k, :k] = S
+    S2[k, :k], S2[k + 1, :k] = -I8[0, 2], -I8[1, 2]
+    S2[:k, k], S2[:k, k + 1] = I8[0, 2], I8[1, 2]
+    S2[k, k + 1], S2[k + 1, k] = Z, -Z
+    b2 = np.concatenate([b, [inertia[1, 2], -inertia[0, 2]]])
+    c2 = np.concatenate([c, [inertia[0, 2], inertia[1, 2]]])
+    m = len(centres)
+    im2 = np.zeros((m, 6, k + 2))
+    im2[:, :, :k] = imap
+    zb = centres[:, 2] - com[2]
+    im2[:, 1, k] = -zb            # tilt about x: y translation −z̄, rotation about x 1
+    im2[:, 3, k] = 1.0
+    im2[:, 0, k + 1] = zb         # tilt about y: x translation z̄, rotation about y 1
+    im2[:, 4, k + 1] = 1.0
+    return G2, b2, S2, c2, im2
+
+
+__all__ = ["DEFAULT_DAMPING", "FlexibleBody", "load_flexible_body", "tilt_terms"]
