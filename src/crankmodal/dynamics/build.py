@@ -65,12 +65,17 @@ def check_ring_friction(force: float, cylinders) -> None:
             f"integrator step can follow; must be <= {m * v_f / MIN_FRICTION_TIME:.3g} N")
 
 
-def build_mechanism(p, mechanism_params=None):
+def build_mechanism(p, mechanism_params=None, bodies=None):
     """The mechanism described by validated parameters ``p``.
 
     ``mechanism_params`` are the validated ``[mechanism]`` parameters, used when
-    ``p["from_mechanism"]`` is set.
+    ``p["from_mechanism"]`` is set. ``bodies`` (crank trains): ``{"crank": (body, roles) or
+    None, "rods": [body or None per cylinder] or None}`` replacing the rigid crank and rods
+    made from the parameters (:mod:`.flexbuild`).
     """
+    bodies = bodies or {}
+    crank, roles = bodies.get("crank") or (None, None)
+    body_kw = {"crank_body": crank, "crank_roles": roles, "rod_bodies": bodies.get("rods")}
     kw, specs = contact_arguments(p)
     gas = None
     if p["gas_force_deg"] is not None:
@@ -89,7 +94,7 @@ def build_mechanism(p, mechanism_params=None):
         com = mr / ct["crank_mass"] if ct["crank_mass"] > 0 else 0.0
         return crank_train(src["crank_radius"], src["cylinders"], crank_mass=ct["crank_mass"],
                            crank_inertia=ct["crank_inertia"], crank_com=com, kind=p["mechanism"],
-                           **common)
+                           **common, **body_kw)
     common = _common(p, p["speed_rpm"], specs, kw, direction)
     if p["mechanism"] == "four_bar":
         fb = p["four_bar"]
@@ -111,7 +116,7 @@ def build_mechanism(p, mechanism_params=None):
                        crank_inertia=ct["crank_inertia"],
                        crank_com=ct["crank_com"] - (ct["counterweight_mass_radius"] / ct["crank_mass"]
                                                     if ct["crank_mass"] > 0 else 0.0),
-                       kind=p["mechanism"], **common)
+                       kind=p["mechanism"], **common, **body_kw)
 
 
 def _common(p, speed_rpm, specs, kw, direction):

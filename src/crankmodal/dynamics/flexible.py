@@ -116,6 +116,10 @@ class FlexibleBody:
         """Name interface ``frame`` also ``name`` (a mechanism's frame names: ``main``, ``pin``…)."""
         self.frames[name] = self.frames[frame]
 
+    def local(self, frame: str) -> tuple[np.ndarray, float]:
+        """Undeformed position of an interface in the body frame (m) and its angle offset (0)."""
+        return np.array(self.frames[frame][0], float), 0.0
+
     def elastic(self, q: np.ndarray) -> np.ndarray:
         """The elastic modal coordinates of ``q`` (without the tilt coordinates), m kg^½."""
         return q[3:3 + self.n_elastic]
@@ -326,6 +330,7 @@ def load_flexible_body(path, name: str, n_modes: int | None = None,
         interfaces={n: (centres[i], imap[i]) for i, n in enumerate(names)},
         damping_ratio=zeta, z=z, n_tilt=n_tilt, orientation=orientation,
         info={"file": str(path), "part": fb.name, "left_out": left,
+              "mode_columns": cols.tolist(),
               "interface_centres": {n: centres[i].tolist() for i, n in enumerate(names)}})
 
 

@@ -45,6 +45,8 @@ class History:
     peaks : dict joint -> dict of arrays at the deepest penetration of each contact (located as
         events, not sampled): ``t`` (s), ``fn`` (N), ``penetration`` (m), ``main_bearing_force``
         (magnitude, N) and ``piston_acceleration`` (n, P) (m/s^2) at that instant.
+    modal : dict body name -> (K, k) the flexible bodies' modal coordinates (elastic, then
+        tilts), m kg^½ (tilts in rad).
     """
 
     t: np.ndarray
@@ -67,6 +69,7 @@ class History:
     peaks: dict = field(default_factory=dict)
     nfev: int = 0
     wall_time: float = 0.0
+    modal: dict = field(default_factory=dict)
 
     def energy_error(self) -> float:
         """Largest |residual| of the energy balance relative to the energy exchanged in the run
@@ -116,6 +119,8 @@ class History:
         for name, pk in self.peaks.items():
             for k, v in pk.items():
                 out[f"peaks_{name}_{k}"] = v
+        for name, v in self.modal.items():
+            out[f"modal_{name}"] = v
         return out
 
     def peak(self, key: str, sampled, name: str | None = None, since: float | None = None):
@@ -214,7 +219,10 @@ def record(mech, sysm, integ) -> History:
                                                 + energy["work_constraints"]
                                                 - energy["dissipated_contact"]
                                                 - energy["dissipated_friction"])
-    main = forces.get(mech.main_joint, np.zeros((K, 2)))
+    # the force of the crank on the housing: the sum over its main journals
+    main = np.zeros((K, 2))
+    for name in getattr(mech, "main_joints", None) or [mech.main_joint]:
+        main = main + forces.get(name, 0.0)
     moment = np.zeros((K, 2))
     for name, z in mech.rows_z.items():
         f = forces.get(name)
@@ -230,7 +238,9 @@ def record(mech, sysm, integ) -> History:
                    onsets={cj.name: integ.onsets[i] for i, cj in enumerate(sysm.clearances)},
                    separations={cj.name: integ.separations[i]
                                 for i, cj in enumerate(sysm.clearances)},
-                   peaks=_record_peaks(mech, sysm, integ, pins))
+                   peaks=_record_peaks(mech, sysm, integ, pins),
+                   modal={b.name: integ.y[sysm.slices[id(b)].start + 3: sysm.slices[id(b)].stop].T
+                          .copy() for b in getattr(sysm, "_elastic", ())})
 
 
 def _solve_at(sysm, integ, t, q, qd) -> dict:
@@ -257,12 +267,12 @@ def _record_peaks(mech, sysm, integ, pins) -> dict:
             s = _solve_at(sysm, integ, t, y[:n], y[n:2 * n])
             ck = s["contacts"][j]
             d["t"][k], d["fn"][k], d["penetration"][k] = t, ck["fn"], ck["delta"]
-            if mech.main_joint in rows:
-                f = s["lam"][rows[mech.main_joint]]
-            elif mech.main_joint in names:
-                f = s["contacts"][names.index(mech.main_joint)]["force"]
-            else:
-                f = np.zeros(2)
+            f = np.zeros(2)
+            for name in getattr(mech, "main_joints", None) or [mech.main_joint]:
+                if name in rows:
+                    f = f + s["lam"][rows[name]]
+                elif name in names:
+                    f = f + s["contacts"][names.index(name)]["force"]
             d["main_bearing_force"][k] = float(np.hypot(f[0], f[1]))
             for i, sl in enumerate(piston_sl):
                 d["piston_acceleration"][k, i] = mech.axes[i] @ s["qdd"][sl][:2]

@@ -58,6 +58,19 @@ class Mechanism:
     revolution_hz: float = 1.0
     main_joint: str = "main"
     rows_z: dict = field(default_factory=dict)
+    main_joints: list = field(default_factory=list)
+    rods: list = field(default_factory=list)
+
+    def __post_init__(self):
+        if not self.main_joints:
+            self.main_joints = [self.main_joint]
+
+
+def _offset(body, frame) -> np.ndarray:
+    """Undeformed position of a body's frame relative to its reference point, m."""
+    if isinstance(body, RigidBody):
+        return body.local(frame)[0]
+    return np.asarray(body.frames[frame][0], float)
 
 
 def _unit(angle):
@@ -115,8 +128,15 @@ def _drive(crank, omega, theta0, ramp_time, drive_torque, crank_frame="main"):
 def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inertia=0.0,
                 crank_com=0.0, theta0=0.0, ramp_time=0.0, drive_torque=None, clearances=None,
                 contact_kw=None, gravity=(0.0, 0.0), baumgarte=None, kind="slider_crank",
-                direction=1):
+                direction=1, crank_body=None, crank_roles=None, rod_bodies=None):
     """Slider-crank train: one crank, ``len(cylinders)`` rods on one crankpin, pistons.
+
+    The crank and the rods are rigid bodies made from the parameters, or the body objects given
+    (e.g. flexible ones, :mod:`~.flexbuild`): ``crank_body`` with ``crank_roles`` naming its
+    frames (``mains``: one per main journal, each pinned to the ground as joint ``main``, or
+    ``main_1``, ``main_2``… when there are several; ``pins``: the frame carrying each rod;
+    ``drive``: the frame the speed or torque drives), and ``rod_bodies`` (one per cylinder, or
+    None for a rigid one) with frames ``big`` and ``small`` and body x from big to small end.
 
     Parameters
     ----------
@@ -155,24 +175,43 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     baumgarte = max(50.0, 2.0 * abs(omega)) if baumgarte is None else baumgarte
     ground = Ground(frames={"main": (0.0, 0.0)})
     r, b = crank_radius, crank_com
-    crank = RigidBody("crank", max(crank_mass, 0.0), max(crank_inertia, 1e-12),
-                      {"main": (-b, 0.0), "pin": (r - b, 0.0)})
-    bodies, q0, qd0 = [crank], [], []
     rw = omega if ramp_time <= 0.0 else 0.0
     c0, s0 = np.cos(theta0), np.sin(theta0)
-    q0 += [b * c0, b * s0, theta0]
-    qd0 += [-b * s0 * rw, b * c0 * rw, rw]
-    pins = [Revolute("main", crank, "main", ground, "main")]
+    A0 = np.array([[c0, -s0], [s0, c0]])
+    if crank_body is None:
+        crank = RigidBody("crank", max(crank_mass, 0.0), max(crank_inertia, 1e-12),
+                          {"main": (-b, 0.0), "pin": (r - b, 0.0)})
+        mains, pin_frames, drive_frame = ["main"], ["pin"] * len(cylinders), "main"
+        q_crank = np.array([b * c0, b * s0, theta0])
+    else:
+        crank = crank_body
+        mains, pin_frames = list(crank_roles["mains"]), list(crank_roles["pins"])
+        drive_frame = crank_roles["drive"]
+        s_main = _offset(crank, mains[0])
+        q_crank = np.concatenate([-A0 @ s_main, [theta0], np.zeros(crank.ndof - 3)])
+    # rigid rotation about the axis at rw: v = rw e_z x (position of the frame origin)
+    qd_crank = np.zeros(crank.ndof)
+    qd_crank[:3] = [-q_crank[1] * rw, q_crank[0] * rw, rw]
+    bodies, q0, qd0 = [crank], list(q_crank), list(qd_crank)
+    main_names = ["main"] if len(mains) == 1 else [f"main_{j}" for j in range(1, len(mains) + 1)]
+    pins = [Revolute(nm, crank, fr, ground, "main") for nm, fr in zip(main_names, mains)]
     others, loads, pistons, axes, rows_z = [], [], [], [], {}
-    angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque)
+    angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque, drive_frame)
     others.append(angle_drive)
-    P = r * np.array([c0, s0])
+    rods = []
     for i, cyl in enumerate(cylinders, start=1):
         u = _unit(cyl.axis_angle)
         nrm = np.array([-u[1], u[0]])
-        a, L = cyl.rod_com, cyl.rod_length
-        rod = RigidBody(f"rod_{i}", cyl.rod_mass, cyl.rod_inertia,
-                        {"big": (-a, 0.0), "small": (L - a, 0.0)}, z=cyl.z)
+        P = crank.frame_pose(q_crank, pin_frames[i - 1])[:2]
+        rod = rod_bodies[i - 1] if rod_bodies and rod_bodies[i - 1] is not None else None
+        if rod is None:
+            a, L = cyl.rod_com, cyl.rod_length
+            rod = RigidBody(f"rod_{i}", cyl.rod_mass, cyl.rod_inertia,
+                            {"big": (-a, 0.0), "small": (L - a, 0.0)}, z=cyl.z)
+        else:
+            rod.z = cyl.z
+        s_big = _offset(rod, "big")
+        L = float(np.hypot(*(_offset(rod, "small") - s_big)))
         piston = RigidBody(f"piston_{i}", cyl.piston_mass, 1.0e-6, {"pin": (0.0, 0.0)}, z=cyl.z)
         h = P @ nrm - cyl.offset
         if abs(h) >= L:
@@ -181,11 +220,13 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         X = s * u + cyl.offset * nrm
         d = X - P
         phi = np.arctan2(d[1], d[0])
-        G = P + a * d / L
-        q0 += [G[0], G[1], phi, X[0], X[1], cyl.axis_angle]
-        qd0 += [0.0] * 6
+        A = np.array([[np.cos(phi), -np.sin(phi)], [np.sin(phi), np.cos(phi)]])
+        G = P - A @ s_big
+        q0 += [G[0], G[1], phi] + [0.0] * (rod.ndof - 3) + [X[0], X[1], cyl.axis_angle]
+        qd0 += [0.0] * (rod.ndof + 3)
         bodies += [rod, piston]
-        pins += [Revolute(f"big_end_{i}", crank, "pin", rod, "big"),
+        rods.append(rod)
+        pins += [Revolute(f"big_end_{i}", crank, pin_frames[i - 1], rod, "big"),
                  Revolute(f"small_end_{i}", piston, "pin", rod, "small")]
         others.append(Prismatic(f"slider_{i}", piston, "pin", cyl.offset * nrm, u, cyl.axis_angle))
         loads.append(PistonLoads(piston, "pin", u, cyl.axis_angle, crank, "main",
@@ -195,7 +236,8 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         rows_z[f"big_end_{i}"] = cyl.z
     return _finish(kind, bodies, pins, others, loads, clearances or {}, contact_kw or {},
                    np.array(q0), np.array(qd0), crank, drive, gravity, baumgarte,
-                   pistons=pistons, axes=axes, revolution_hz=speed_rpm / 60.0, rows_z=rows_z)
+                   pistons=pistons, axes=axes, revolution_hz=speed_rpm / 60.0, rows_z=rows_z,
+                   main_joint=main_names[0], main_joints=main_names, rods=rods)
 
 
 def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, inertias,

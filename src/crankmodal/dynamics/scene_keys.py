@@ -53,6 +53,9 @@ SCHEMA = {
     "contact": Field("table", {}, "normal contact law and parameters"),
     "friction": Field("table", {}, "friction law and parameters"),
     "solver": Field("table", {}, "integrator settings"),
+    "flexible": Field("table", {}, "flexible (Craig-Bampton) bodies: crank = {...}, rods = {...}"),
+    "run_rigid": Field("bool", True, "with flexible bodies, also run the rigid twin (the same "
+                       "parts' mass properties, modes frozen) for side-by-side results"),
 }
 
 CRANK_TRAIN = {
@@ -148,6 +151,53 @@ SOLVER = {
 }
 
 
+FLEXIBLE = {
+    "crank": Field("table", {}, "the crank as a flexible body (absent: rigid; crank = {} "
+                   "flexible with the defaults)"),
+    "rods": Field("table", {}, "every rod as a flexible body (absent: rigid; rods = {} flexible "
+                  "with the defaults)"),
+}
+
+FLEX_BODY = {
+    "file": Field("str", None, "a crankmodal-flexbody .npz (relative to the scene); default: the "
+                  "machine's part reduced here and cached"),
+    "n_modes": Field("int", None, "in-plane elastic modes kept, lowest first (0: frozen; default "
+                     "all up to cutoff_hz, or all stored)", ge=0, le=400),
+    "cutoff_hz": Field("float", None, "keep the in-plane elastic modes up to this frequency, Hz",
+                       gt=0.0),
+    "damping_ratio": Field("float", 0.02, "modal damping ratio of every kept mode", ge=0.0,
+                           lt=1.0),
+    "material": Field("str", "steel", "library material of the part (reduced here)"),
+    "fidelity": Field("str", "full", "part fidelity (reduced here): full, dechamfered, simplified",
+                      choices=("full", "dechamfered", "simplified")),
+    "mesh_size": Field("float", None, "mesh size of the part reduced here, m (default: crank "
+                       "0.016, rod 0.010)", gt=0.0),
+    "element_order": Field("int", 2, "1 or 2", check=lambda v: None if v in (1, 2)
+                           else "must be 1 or 2"),
+    "fixed_interface_modes": Field("int", 20, "fixed-interface modes of the reduction here",
+                                   ge=0, le=400),
+}
+
+DEFAULT_MESH_SIZE = {"crank": 0.016, "rods": 0.010}
+
+
+def validate_flexible(raw: dict) -> dict:
+    """``[dynamics.flexible]``: validated ``crank`` and ``rods`` tables, or None for rigid."""
+    f = validate("dynamics.flexible", raw, FLEXIBLE)
+    for key in ("crank", "rods"):
+        if not raw.get(key) and key not in raw:
+            f[key] = None
+            continue
+        b = validate(f"dynamics.flexible.{key}", f[key], FLEX_BODY)
+        if b["n_modes"] is not None and b["cutoff_hz"] is not None:
+            raise SceneError(f"dynamics.flexible.{key}.cutoff_hz: give either n_modes or "
+                             "cutoff_hz, not both")
+        if b["mesh_size"] is None:
+            b["mesh_size"] = DEFAULT_MESH_SIZE[key]
+        f[key] = b
+    return f
+
+
 def validate_section(raw: dict) -> dict:
     """Validate ``[dynamics]`` and its sub-tables; return the parameters."""
     p = validate("dynamics", raw, SCHEMA)
@@ -158,6 +208,7 @@ def validate_section(raw: dict) -> dict:
     p["contact"] = validate("dynamics.contact", p["contact"], CONTACT)
     p["friction"] = validate("dynamics.friction", p["friction"], FRICTION)
     p["solver"] = validate("dynamics.solver", p["solver"], SOLVER)
+    p["flexible"] = validate_flexible(p["flexible"])
     _cross_checks(p)
     return p
 
@@ -243,6 +294,14 @@ def _cross_checks(p):
     if p["drive_torque"] is not None and p["mechanism"] != "four_bar" and ct["crank_inertia"] <= 0:
         raise SceneError("dynamics.crank_train.crank_inertia: must be > 0 (crank and flywheel, "
                          "kg m^2) when drive_torque sets the speed free")
+    flex = p["flexible"]
+    if flex["crank"] is not None or flex["rods"] is not None:
+        if p["mechanism"] == "four_bar":
+            raise SceneError("dynamics.flexible: flexible bodies go into crank trains "
+                             "(slider_crank, four_star); the four-bar's links are rigid here")
+        if flex["crank"] is not None and p["drive_torque"] is not None:
+            raise SceneError("dynamics.drive_torque: with a flexible crank the speed is "
+                             "prescribed (the part carries no flywheel); remove drive_torque")
     if p["drive_torque"] is not None and p["ramp_time"] > 0:
         raise SceneError("dynamics.ramp_time: must be 0 with drive_torque (the torque drives)")
     if p["ramp_time"] >= p["end_time"] and p["ramp_time"] > 0:

@@ -15,10 +15,19 @@ REQUIRES = ()
 
 
 def validate(raw: dict, scene) -> dict:
+    from pathlib import Path
+
     from ..errors import SceneError
     from .scene_keys import check_speed, validate_section
 
     p = validate_section(raw)
+    for key in ("crank", "rods"):
+        spec = p["flexible"][key]
+        if spec is not None and spec["file"] is not None:
+            path = scene.resolve(spec["file"]) if scene is not None else Path(spec["file"])
+            if not path.is_file():
+                raise SceneError(f"dynamics.flexible.{key}.file: no file {str(path)!r}")
+            spec["file"] = str(path)
     if p["from_mechanism"] and (scene is None or "mechanism" not in scene.sections):
         raise SceneError("dynamics.from_mechanism: needs a [mechanism] section in the scene")
     if p["speed_rpm"] is not None:
@@ -80,7 +89,12 @@ def run(params: dict, ctx) -> dict:
     from .validity import penetration_warning
 
     p = params
-    mech = build_mechanism(p, ctx.params.get("mechanism"))
+    bodies = None
+    if p["flexible"]["crank"] is not None or p["flexible"]["rods"] is not None:
+        from .flexstage import make_bodies
+
+        bodies = make_bodies(p, ctx.params.get("mechanism"))
+    mech = build_mechanism(p, ctx.params.get("mechanism"), bodies)
     rev_hz = mech.revolution_hz
     settings = solver_settings(p, 60.0 * rev_hz)
     dt = p["output_step"] or 1.0 / (360.0 * rev_hz)
@@ -97,6 +111,12 @@ def run(params: dict, ctx) -> dict:
     ideal = None
     if p["run_ideal"] and mech.system.clearances:
         ideal = simulate(mech, t_end, dt, settings, ideal=True, energy_tolerance=tol)
+    rigid = None
+    if bodies is not None and p["run_rigid"]:
+        from .flexstage import rigid_twins
+
+        rigid_mech = build_mechanism(p, ctx.params.get("mechanism"), rigid_twins(bodies))
+        rigid = simulate(rigid_mech, t_end, dt, settings, energy_tolerance=tol)
     sel, n_rev = _window(hist, p, rev_hz)
     orders = list(range(13))
     res = {"mechanism": mech.kind, "speed_rpm": 60.0 * rev_hz, "revolution_hz": rev_hz,
@@ -154,12 +174,19 @@ def run(params: dict, ctx) -> dict:
             "piston_acceleration_peak": np.max(np.abs(ideal.piston_acceleration), axis=0).tolist()
             if ideal.piston_acceleration.size else [],
             "drive_power_mean_w": float(np.mean(ideal.drive_power[sel]))}
+    if bodies is not None:
+        from .flexstage import flexible_results
+
+        res["flexible"] = flexible_results(mech, hist, rigid, sel, rev_hz, bodies)
+        res["flexible"]["rigid_integration_wall_time_s"] = None if rigid is None else rigid.wall_time
     study = None
     if p["solver"]["study_rtols"]:
         rt = sorted(set(p["solver"]["study_rtols"]) | {settings.rtol / 10})
         study = tolerance_study(mech, t_end, dt, rt, t_start=float(hist.t[sel][0]), base=settings)
         res["tolerance_study"] = study
     arrays = hist.arrays()
+    if rigid is not None:
+        arrays.update({f"rigid_{k}": v for k, v in rigid.arrays().items()})
     if ideal is not None:
         arrays.update({f"ideal_{k}": v for k, v in ideal.arrays().items()})
         for cj in mech.system.clearances:
@@ -178,6 +205,11 @@ def run(params: dict, ctx) -> dict:
     res["arrays"] = "dynamics.npz"
     if ctx.figures:
         res["figures"] = _figures(hist, ideal, mech, sel, study, out, spec)
+        if bodies is not None:
+            from .flexplots import flexible_figures
+
+            res["flexible"]["figures"] = flexible_figures(hist, rigid, mech, sel, out)
+            res["figures"] += res["flexible"]["figures"]
     k = key_outputs(hist, rev_hz, float(hist.t[sel][0]))
     n_imp = sum(j["impact_count"] for j in joints.values())
     if mech.pistons:
@@ -191,7 +223,15 @@ def run(params: dict, ctx) -> dict:
         headline_text = f"main-bearing peak {res['main_bearing_force_peak_n']:.4g} N, {motion}"
     res["summary"] = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {t_end:g} s: {headline_text}, "
                       f"{n_imp} impacts, energy balance {res['energy_balance_error']:.1e}")
-    ctx.products[SECTION] = {"mechanism": mech, "history": hist, "ideal": ideal}
+    if bodies is not None:
+        names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in res["flexible"]["bodies"].items())
+        res["summary"] += f"; flexible: {names}"
+        cmp = res["flexible"].get("rigid", {}).get("main_bearing")
+        if cmp:
+            res["summary"] += (f"; main bearing flexible vs rigid: peak {cmp['peak_n']:.4g} vs "
+                               f"{cmp['rigid_peak_n']:.4g} N, RMS of the difference "
+                               f"{100 * cmp['relative_difference_rms']:.2g} % of the rigid RMS")
+    ctx.products[SECTION] = {"mechanism": mech, "history": hist, "ideal": ideal, "rigid": rigid}
     return res
 
 

@@ -1,0 +1,240 @@
+"""Flexible crank and rods for a crank train: reduce the machine's parts (cached) and make bodies.
+
+The chain of :mod:`crankmodal.geometry` → :mod:`crankmodal.fem` → :mod:`crankmodal.reduction`
+run for one part of a machine file, its Craig–Bampton body stored under
+``$CRANKMODAL_CACHE/flexbodies/<key>.npz`` (key: the part's cache key, the material, the
+interfaces, the reduction settings and the reduction package's source), then read as a planar
+:class:`~.flexible.FlexibleBody` with the frame names a crank train uses:
+
+- crank: ``main_<j>`` one per main journal (j from 1), ``pin_<i>`` the crankpin band carrying rod
+  ``i`` (the band whose axial position is nearest the rod's row), ``drive`` (the flywheel end face
+  if the part has one, else the first journal); body axes turned so that the frame angle is the
+  crank angle (pin along +x), with the two rigid tilts (a shaft held at two journals).
+- rod: ``big`` and ``small`` (the bores), body x axis from the big to the small end.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+
+#: relative tolerance on the crank radius and rod length a reduced body must match
+GEOMETRY_TOLERANCE = 0.01
+
+
+def flexbody_cache_dir() -> Path:
+    """``$CRANKMODAL_CACHE/flexbodies`` (default ``~/.cache/crankmodal/flexbodies``)."""
+    root = os.environ.get("CRANKMODAL_CACHE") or Path.home() / ".cache" / "crankmodal"
+    return Path(root) / "flexbodies"
+
+
+def _reduction_source_digest() -> str:
+    h = hashlib.sha256()
+    for folder in ("reduction", "fem"):
+        for path in sorted((Path(__file__).parent.parent / folder).glob("*.py")):
+            h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def crank_interface_specs(regions, rods_per_pin: int) -> list[dict]:
+    """Distributing interfaces of a crankshaft part: each main journal, each crankpin region cut
+    into ``rods_per_pin`` bands, and the flywheel end face if present."""
+    mains = sorted(n for n in regions if n.startswith("main_journal"))
+    pins = sorted(n for n in regions if n.startswith("crankpin"))
+    if len(mains) < 1 or not pins:
+        raise SceneError("dynamics.flexible.crank: the part has no main_journal_* or crankpin_* "
+                         f"regions (regions: {', '.join(sorted(regions))})")
+    specs = [{"region": n, "kind": "distributing", "segments": 1} for n in mains]
+    specs += [{"region": n, "kind": "distributing", "segments": rods_per_pin} for n in pins]
+    if "flywheel_end_face" in regions:
+        specs.append({"region": "flywheel_end_face", "kind": "distributing", "segments": 1})
+    return specs
+
+
+def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
+    """The ``crankmodal-flexbody`` file of a machine's part, reduced once and cached.
+
+    Parameters
+    ----------
+    machine : str
+        Machine file name (``geometry/<machine>.toml``).
+    part : {"crankshaft", "rod"}
+    spec : dict
+        Validated ``[dynamics.flexible.<body>]`` keys: ``fidelity``, ``mesh_size`` (m),
+        ``element_order``, ``material``, ``fixed_interface_modes``.
+    n_rods : int
+        Rods on the crank (crankshaft only): each crankpin region is cut into
+        ``ceil(n_rods / crankpin regions)`` bands, one interface each.
+    """
+    from types import SimpleNamespace
+
+    from ..fem.assembly import assemble
+    from ..fem.material_stage import make_material
+    from ..fem.material_stage import validate as validate_material
+    from ..geometry.cache import part_key
+    from ..geometry.stage import make_part
+    from ..geometry.stage import validate as validate_geometry
+    from ..reduction.interfaces import make_interfaces
+    from ..reduction.io import save_flexbody
+    from ..reduction.reduce import reduce_body
+    from ..reduction.stage import interface_specs
+
+    where = f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
+    raw = {"machine": machine, "part": part, "fidelity": spec["fidelity"],
+           "mesh_size": spec["mesh_size"], "element_order": spec["element_order"]}
+    try:
+        gp = validate_geometry(raw, SimpleNamespace(sections={"reduction": {}}))
+        mp = validate_material({"name": spec["material"]}, None)
+    except SceneError as exc:
+        raise SceneError(f"{where}: {exc}") from None
+    desc = {"part": part, "params": gp["part_params"].to_dict(), "fidelity": gp["fidelity"],
+            "mesh": {"size": spec["mesh_size"], "order": spec["element_order"]}}
+    key_text = json.dumps({"part": part_key(desc), "material": spec["material"],
+                           "modes": spec["fixed_interface_modes"], "n_rods": n_rods,
+                           "source": _reduction_source_digest(), "format": 1}, sort_keys=True)
+    key = hashlib.sha256(key_text.encode()).hexdigest()[:32]
+    path = flexbody_cache_dir() / f"{machine}_{part}_{key}.npz"
+    if path.is_file():
+        return path
+    prt, _ = make_part(gp)
+    mat = make_material(mp)
+    model = assemble(prt, mat)
+    if part == "crankshaft":
+        n_pins = sum(1 for n in prt.regions if n.startswith("crankpin"))
+        specs = crank_interface_specs(prt.regions, -(-n_rods // max(n_pins, 1)))
+    else:
+        specs = [{"region": n, "kind": "distributing", "segments": 1}
+                 for n in ("big_end_bore", "small_end_bore")]
+    itf = make_interfaces(prt, interface_specs(prt, {"interfaces": specs, "coupling": "distributing"}))
+    body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"], mesh=prt.mesh,
+                          name=prt.name, info={"part": prt.name, "material": mat.name,
+                                               "machine": machine})
+    path.parent.mkdir(parents=True, exist_ok=True)
+    save_flexbody(path, body)  # atomic
+    return path
+
+
+def _in_plane_angle(v) -> float:
+    return float(np.arctan2(v[1], v[0]))
+
+
+def crank_body(path, spec: dict, row_z, crank_radius: float | None, name: str = "crank"):
+    """A planar flexible crank from a flexbody file, frames named for a crank train.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``crankmodal-flexbody`` file of a crankshaft (interfaces ``main_journal_*``,
+        ``crankpin_*`` bands, optionally ``flywheel_end_face``).
+    spec : dict
+        ``n_modes`` / ``cutoff_hz`` / ``damping_ratio``.
+    row_z : sequence of float
+        Axial position of each rod's row relative to the crankpin's middle, m.
+    crank_radius : float or None
+        The mechanism's crank radius, m, checked against the file (±1 %).
+
+    Returns
+    -------
+    body : FlexibleBody
+    roles : dict
+        ``mains`` (frame names), ``pins`` (one per rod), ``drive``.
+    """
+    from .flexible import load_flexible_body
+
+    probe = load_flexible_body(path, name, n_modes=0)
+    centres = {n: np.asarray(c, float) for n, c in probe.info["interface_centres"].items()}
+    mains = sorted(n for n in centres if n.startswith("main_journal"))
+    bands = sorted(n for n in centres if n.startswith("crankpin"))
+    if not mains or not bands:
+        raise SceneError(f"dynamics.flexible.crank.file: {path}: needs main_journal_* and "
+                         f"crankpin_* interfaces; has {', '.join(sorted(centres)) or 'none'}")
+    axis0 = np.mean([centres[n] for n in mains], axis=0)
+    pin_mid = np.mean([centres[n] for n in bands], axis=0)
+    arm = pin_mid[:2] - axis0[:2]
+    r_file = float(np.hypot(*arm))
+    if crank_radius is not None and abs(r_file / crank_radius - 1) > GEOMETRY_TOLERANCE:
+        raise SceneError(f"dynamics.flexible.crank.file: {path}: its crankpin is {r_file:.5g} m "
+                         f"from the main journals' axis, the mechanism's crank radius is "
+                         f"{crank_radius:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
+    pins = []
+    for z in row_z:
+        dz = [abs(centres[n][2] - pin_mid[2] - z) for n in bands]
+        pins.append(bands[int(np.argmin(dz))])
+    drive = "flywheel_end_face" if "flywheel_end_face" in centres else mains[0]
+    body = load_flexible_body(path, name, n_modes=spec.get("n_modes"),
+                              cutoff_hz=spec.get("cutoff_hz"),
+                              damping_ratio=spec["damping_ratio"], tilt=len(mains) > 1,
+                              orientation=_in_plane_angle(arm))
+    roles = {"mains": [], "pins": [], "drive": "drive"}
+    for j, n in enumerate(mains, start=1):
+        body.alias(f"main_{j}", n)
+        roles["mains"].append(f"main_{j}")
+    for i, n in enumerate(pins, start=1):
+        body.alias(f"pin_{i}", n)
+        roles["pins"].append(f"pin_{i}")
+    body.alias("drive", drive)
+    body.alias("main", mains[0])
+    body.info["roles"] = {"mains": mains, "pins": pins, "drive": drive}
+    return body, roles
+
+
+def rod_body(path, spec: dict, rod_length: float | None, name: str, z: float = 0.0):
+    """A planar flexible rod from a flexbody file with ``big_end_bore`` and ``small_end_bore``
+    interfaces: frames ``big`` and ``small``, body x axis from the big to the small end; its
+    length checked against the mechanism's ``rod_length`` (m, ±1 %)."""
+    from .flexible import load_flexible_body
+
+    probe = load_flexible_body(path, name, n_modes=0,
+                               interfaces=("big_end_bore", "small_end_bore"))
+    c = probe.info["interface_centres"]
+    d = np.asarray(c["small_end_bore"], float)[:2] - np.asarray(c["big_end_bore"], float)[:2]
+    length = float(np.hypot(*d))
+    if rod_length is not None and abs(length / rod_length - 1) > GEOMETRY_TOLERANCE:
+        raise SceneError(f"dynamics.flexible.rods.file: {path}: its bores are {length:.5g} m "
+                         f"apart, the mechanism's rod length is {rod_length:.5g} m "
+                         f"(tolerance {GEOMETRY_TOLERANCE:.0%})")
+    body = load_flexible_body(path, name, n_modes=spec.get("n_modes"),
+                              cutoff_hz=spec.get("cutoff_hz"),
+                              damping_ratio=spec["damping_ratio"], z=z,
+                              orientation=_in_plane_angle(d))
+    body.alias("big", "big_end_bore")
+    body.alias("small", "small_end_bore")
+    return body
+
+
+def rigid_twin(body):
+    """The rigid body with a flexible body's mass, inertia and frames (its modes frozen).
+
+    A crank with tilts (held at two or more journals) stays a :class:`~.flexible.FlexibleBody`
+    with its tilts and no elastic mode, so that each journal's force is still defined; any
+    other body becomes a :class:`~.bodies.RigidBody` (the fast path).
+    """
+    from .bodies import RigidBody
+    from .flexible import FlexibleBody
+
+    if body.n_tilt:
+        k = body.n_modes
+        keep = np.r_[k - body.n_tilt:k]
+        frames = {n: (s0, D[:, keep], rz[keep]) for n, (s0, D, rz) in body.frames.items()}
+        twin = FlexibleBody.__new__(FlexibleBody)
+        twin.__dict__.update(body.__dict__)
+        twin.frequencies_hz = body.frequencies_hz[keep]
+        twin.n_modes, twin.n_elastic, twin.ndof = body.n_tilt, 0, 3 + body.n_tilt
+        for a in ("zeta", "K", "C", "b", "c"):
+            setattr(twin, a, getattr(body, a)[keep])
+        twin.G, twin.S = body.G[np.ix_(keep, keep)], body.S[np.ix_(keep, keep)]
+        twin.frames = frames
+        twin.info = dict(body.info, rigid_twin=True)
+        return twin
+    frames = {n: (float(s0[0]), float(s0[1])) for n, (s0, _, _) in body.frames.items()}
+    return RigidBody(body.name, body.mass, body.j0, frames, z=body.z)
+
+
+__all__ = ["crank_body", "crank_interface_specs", "flexbody_cache_dir", "reduced_part",
+           "rigid_twin", "rod_body"]

@@ -1,0 +1,219 @@
+"""The ``[dynamics.flexible]`` part of the stage: flexible bodies in, flexible-vs-rigid results out.
+
+:func:`make_bodies` turns the validated tables into body objects (:mod:`.flexbuild`), and
+:func:`rigid_twins` their rigid twins (same mass properties and frames, modes frozen).
+:func:`flexible_results` compares a flexible run with its rigid twin: the main-bearing force
+(sum and per journal: peak, RMS, order amplitudes, the RMS of the difference), the modal
+coordinates, the interfaces' elastic deflections and the dynamic stress of each flexible body
+from its stress modes (largest von Mises over the run: where and when).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SceneError
+
+#: output samples processed at once when the stress modes are superposed
+STRESS_CHUNK = 64
+
+
+def train_geometry(p, mechanism_params):
+    """Crank radius (m), rod lengths (m) and row positions (m) of the crank train."""
+    if p["from_mechanism"]:
+        from .bridge import cylinders_from_mechanism
+
+        src = cylinders_from_mechanism(mechanism_params, p["ring_friction_n"])
+        cyl = src["cylinders"]
+        return src["crank_radius"], [c.rod_length for c in cyl], [c.z for c in cyl]
+    from .scene_keys import cylinder_angles
+
+    ct = p["crank_train"]
+    n = len(cylinder_angles(p))
+    return ct["crank_radius"], [ct["rod_length"]] * n, list(ct["row_z"] or [0.0] * n)
+
+
+def _file(spec, machine, part, n_rods, key):
+    from .flexbuild import reduced_part
+
+    if spec["file"] is not None:
+        return Path(spec["file"])
+    if not machine:
+        raise SceneError(f"dynamics.flexible.{key}.file: give a crankmodal-flexbody .npz, or "
+                         "dynamics.machine so that the machine's part is reduced here")
+    return reduced_part(machine, part, spec, n_rods=n_rods)
+
+
+def make_bodies(p, mechanism_params=None) -> dict | None:
+    """Flexible bodies of validated ``[dynamics]`` parameters, or None when all are rigid.
+
+    Returns ``{"crank": (body, roles) or None, "rods": [body per cylinder] or None,
+    "files": {name: path}}``.
+    """
+    from .flexbuild import crank_body, rod_body
+
+    flex = p["flexible"]
+    if flex["crank"] is None and flex["rods"] is None:
+        return None
+    from ..errors import InputFileError
+
+    radius, lengths, rows = train_geometry(p, mechanism_params)
+    machine = p.get("machine")
+    out = {"crank": None, "rods": None, "files": {}}
+    key = "crank"
+    try:
+        if flex["crank"] is not None:
+            path = _file(flex["crank"], machine, "crankshaft", len(rows), "crank")
+            out["crank"] = crank_body(path, flex["crank"], rows, radius)
+            out["files"]["crank"] = str(path)
+        key = "rods"
+        if flex["rods"] is not None:
+            path = _file(flex["rods"], machine, "rod", 1, "rods")
+            out["rods"] = [rod_body(path, flex["rods"], L, f"rod_{i}", z=z)
+                           for i, (L, z) in enumerate(zip(lengths, rows), start=1)]
+            out["files"]["rods"] = str(path)
+    except (SceneError, InputFileError) as exc:
+        if str(exc).startswith("dynamics."):
+            raise
+        raise type(exc)(f"dynamics.flexible.{key}: {exc}") from None
+    return out
+
+
+def rigid_twins(bodies: dict) -> dict:
+    """The same bodies with their modes frozen (:func:`.flexbuild.rigid_twin`)."""
+    from .flexbuild import rigid_twin
+
+    out = {"crank": None, "rods": None}
+    if bodies.get("crank") is not None:
+        body, roles = bodies["crank"]
+        out["crank"] = (rigid_twin(body), roles)
+    if bodies.get("rods") is not None:
+        out["rods"] = [rigid_twin(b) for b in bodies["rods"]]
+    return out
+
+
+def flexible_bodies_of(mech) -> list:
+    """The mechanism's bodies with elastic coordinates."""
+    return [b for b in mech.system.bodies if getattr(b, "n_elastic", 0) > 0]
+
+
+def _rms(x):
+    return float(np.sqrt(np.mean(np.asarray(x) ** 2)))
+
+
+def force_comparison(t, f_flex, f_rigid, rev_hz, orders) -> dict:
+    """Peak, RMS and order amplitudes of a force (K, 2) flexible vs rigid, and their difference."""
+    from .signals import order_amplitudes
+
+    mf, mr = np.hypot(*f_flex.T), np.hypot(*f_rigid.T)
+    diff = np.hypot(*(f_flex - f_rigid).T)
+    out = {"peak_n": float(mf.max()), "rigid_peak_n": float(mr.max()),
+           "rms_n": _rms(mf), "rigid_rms_n": _rms(mr),
+           "difference_rms_n": _rms(diff), "difference_peak_n": float(diff.max()),
+           "relative_difference_rms": _rms(diff) / max(_rms(mr), 1e-300)}
+    n_rev = (t[-1] - t[0]) * rev_hz
+    if n_rev >= 1.0 - 1e-9:
+        a = order_amplitudes(t, f_flex, rev_hz, orders)
+        b = order_amplitudes(t, f_rigid, rev_hz, orders)
+        out["orders"] = list(orders)
+        out["order_amplitude_n"] = np.hypot(a[:, 0], a[:, 1]).tolist()
+        out["rigid_order_amplitude_n"] = np.hypot(b[:, 0], b[:, 1]).tolist()
+    return out
+
+
+def interface_deflections(body, modal) -> dict:
+    """Largest elastic in-plane displacement of each interface in the body frame, m."""
+    k = body.n_elastic
+    out = {}
+    for name, (_, D, _) in body.frames.items():
+        if name in ("main", "drive", "big", "small") or name.startswith(("main_", "pin_")):
+            continue  # aliases of an interface listed under its own name
+        u = modal[:, :k] @ D[:, :k].T
+        out[name] = float(np.hypot(u[:, 0], u[:, 1]).max())
+    return out
+
+
+def von_mises(s) -> np.ndarray:
+    """Von Mises stress of Voigt stresses ``(…, 6)`` (xx yy zz yz xz xy), Pa."""
+    xx, yy, zz, yz, xz, xy = np.moveaxis(s, -1, 0)
+    return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2)
+                   + 3.0 * (yz ** 2 + xz ** 2 + xy ** 2))
+
+
+def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict | None:
+    """Largest von Mises stress of a flexible body over a run, from its stress modes.
+
+    ``σ(t) = Σ_a σ_a ξ_a(t)`` over the kept elastic modes (Pa per unit ξ, stored by the
+    reduction at the mesh nodes); the rigid tilts carry no stress. Returns None when the file
+    holds no stress modes.
+    """
+    from ..reduction.io import load_flexbody
+
+    fb = load_flexbody(body.info["file"])
+    modes = getattr(fb, "stress_modes", None)
+    if modes is None or body.n_elastic == 0:
+        return None
+    cols = np.asarray(body.info["mode_columns"], int)
+    S = np.asarray(modes[:, :, cols], float)  # (p, 6, k)
+    xi = modal[:, :body.n_elastic]
+    best = np.zeros(S.shape[0])
+    when = np.zeros(S.shape[0], int)
+    for k0 in range(0, len(t), STRESS_CHUNK):
+        sig = np.einsum("pik,tk->tpi", S, xi[k0:k0 + STRESS_CHUNK])
+        vm = von_mises(sig)
+        i = np.argmax(vm, axis=0)
+        v = vm[i, np.arange(vm.shape[1])]
+        better = v > best
+        best[better], when[better] = v[better], k0 + i[better]
+    p = int(np.argmax(best))
+    k = int(when[p])
+    out = {"max_von_mises_pa": float(best[p]),
+           "location_m": np.asarray(fb.stress_points)[p].tolist(),
+           "time_s": float(t[k]),
+           "crank_angle_deg": float(np.rad2deg(crank_angle[k]) % 360.0),
+           "n_points": int(S.shape[0]), "n_modes": int(S.shape[2])}
+    if material_strength:
+        out["safety_factor"] = float(material_strength / best[p]) if best[p] > 0 else None
+    return out
+
+
+def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
+    """The ``dynamics.flexible`` results block (see the module docstring)."""
+    t = hist.t[sel]
+    orders = list(range(13))
+    res = {"bodies": {}, "files": bodies.get("files", {})}
+    for b in flexible_bodies_of(mech):
+        modal = hist.modal[b.name]
+        d = {"n_modes": int(b.n_elastic), "frequencies_hz": b.frequencies_hz[:b.n_elastic].tolist(),
+             "damping_ratio": b.zeta[:b.n_elastic].tolist(), "tilts": int(b.n_tilt),
+             "mass_kg": b.mass, "inertia_kgm2": b.j0, "file": b.info.get("file"),
+             "modal_amplitude_max": np.abs(modal[sel]).max(axis=0).tolist(),
+             "interface_deflection_max_m": interface_deflections(b, modal[sel])}
+        lo = b.left_out()
+        d["not_offered_hz"] = [m["hz"] for m in lo.get("not_offered", [])]
+        if "roles" in b.info:
+            d["interfaces"] = b.info["roles"]
+        stress = dynamic_stress(b, modal[sel], t, hist.crank_angle[sel])
+        if stress is not None:
+            d["dynamic_stress"] = stress
+        res["bodies"][b.name] = d
+    if rigid_hist is not None:
+        cmp = {"main_bearing": force_comparison(t, hist.main_bearing_force[sel],
+                                                rigid_hist.main_bearing_force[sel], rev_hz,
+                                                orders)}
+        for name in mech.main_joints:
+            if name in hist.joint_forces and len(mech.main_joints) > 1:
+                cmp[name] = force_comparison(t, hist.joint_forces[name][sel],
+                                             rigid_hist.joint_forces[name][sel], rev_hz, orders)
+        for name in hist.joint_forces:
+            if name.startswith("big_end_") and name in rigid_hist.joint_forces:
+                cmp[name] = force_comparison(t, hist.joint_forces[name][sel],
+                                             rigid_hist.joint_forces[name][sel], rev_hz, orders)
+        res["rigid"] = cmp
+    return res
+
+
+__all__ = ["dynamic_stress", "flexible_results", "force_comparison", "interface_deflections",
+           "make_bodies", "rigid_twins", "train_geometry", "von_mises"]
