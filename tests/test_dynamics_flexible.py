@@ -151,8 +151,10 @@ def test_modal_damping_is_counted_in_the_energy_balance(reduced):
     h = _history(sysm, flex, _run(sysm, q0, np.zeros(5), 0.01, t_out, 1e-10, 1e-13))
     e = h.energy
     assert e["dissipated_modal"][-1] > 0.5 * e["strain"][0]
-    # the residual is the trapezoid's (sampled power), far below what was dissipated
-    assert np.abs(e["residual"]).max() < 1e-3 * e["dissipated_modal"][-1]
+    # modal dissipation is integrated with the run (an ODE state), not summed over the samples:
+    # the books close to the integrator's tolerance (with the trapezoid of the sampled power
+    # they closed only to ~1e-4 of the dissipated energy)
+    assert np.abs(e["residual"]).max() < 1e-7 * e["dissipated_modal"][-1]
 
 
 def _pinned_pinned_fe_hz(reduced):
@@ -237,4 +239,4 @@ def test_cutoff_selects_in_plane_modes_and_reports_what_the_plane_drops(reduced)
     # the out-of-plane bending modes (z, the thin direction) are the lowest and not offered
     assert lo["not_offered"][0]["hz"] < flex.frequencies_hz[0]
     assert lo["not_offered"][0]["in_plane_share"] < 0.05
-    assert isinstance(flex, FlexibleBody) and N_AUX == 5
+    assert isinstance(flex, FlexibleBody) and N_AUX == 6

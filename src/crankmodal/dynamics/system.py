@@ -6,9 +6,10 @@ Equations of motion in body coordinates ``q`` with Lagrange multipliers ``lam``:
     [ Phi_q   0    ] [ lam ] = [ gamma - 2 a Phidot - b**2 Phi        ]
 
 (Baumgarte stabilisation with ``a = b = baumgarte`` in 1/s). The ODE state is
-``y = [q, qd, W_drive, W_loads, W_constraints, D_contact, D_friction]``: the last five are the
-running integrals (J) of the drive power, the power of applied loads, the power of the ideal
-constraint forces (zero up to drift), and the power dissipated by contact damping and by friction.
+``y = [q, qd, W_drive, W_loads, W_constraints, D_contact, D_friction, D_modal]``: the last six
+are the running integrals (J) of the drive power, the power of applied loads, the power of the
+ideal constraint forces (zero up to drift), and the power dissipated by contact damping, by
+friction and by the flexible bodies' modal damping.
 """
 
 from __future__ import annotations
@@ -20,10 +21,10 @@ from . import fastpath
 from .bodies import Ground, RigidBody
 from .joints import AngleDrive
 
-N_AUX = 5
+N_AUX = 6
 _NO_JACOBIAN = np.zeros((3, 0))
 AUX_NAMES = ("work_drive", "work_loads", "work_constraints", "dissipated_contact",
-             "dissipated_friction")
+             "dissipated_friction", "dissipated_modal")
 
 
 class Multibody:
@@ -240,7 +241,9 @@ class Multibody:
         p_drive, p_ideal = self.drive_power(out["lam"], out["Cq"], qd)
         p_damp = sum(c["p_damp"] for c in out["contacts"])
         p_fric = sum(c["p_fric"] for c in out["contacts"])
-        dy = np.concatenate([qd, out["qdd"], [p_drive, out["p_loads"], p_ideal, p_damp, p_fric]])
+        p_modal = self.damping_power(qd) if self._elastic else 0.0
+        dy = np.concatenate([qd, out["qdd"], [p_drive, out["p_loads"], p_ideal, p_damp, p_fric,
+                                              p_modal]])
         if not np.all(np.isfinite(dy)):
             raise NonFinite(t)
         return dy
