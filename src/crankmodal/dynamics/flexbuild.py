@@ -223,7 +223,8 @@ def rigid_twin(body):
         keep = np.r_[k - body.n_tilt:k]
         frames = {n: (s0, D[:, keep], rz[keep]) for n, (s0, D, rz) in body.frames.items()}
         twin = FlexibleBody.__new__(FlexibleBody)
-        twin.__dict__.update(body.__dict__)
+        twin.__dict__.update({a: v for a, v in body.__dict__.items()
+                              if a not in ("_stacked", "_geo", "_bias")})  # no stale caches
         twin.frequencies_hz = body.frequencies_hz[keep]
         twin.n_modes, twin.n_elastic, twin.ndof = body.n_tilt, 0, 3 + body.n_tilt
         for a in ("zeta", "K", "C", "b", "c"):

@@ -175,35 +175,66 @@ class FlexibleBody:
         return 0.5 * float(qd @ self.mass_matrix(q) @ qd)
 
     # ----------------------------------------------------------------- interface frames
-    def _local(self, q, frame):
-        s0, D, rz = self.frames[frame]
+    def _stack(self):
+        """The frames' ``s0``, ``D`` and ``r_z`` stacked (rebuilt when a frame is added)."""
+        names = tuple(self.frames)
+        if getattr(self, "_stacked", (None,))[0] != names:
+            idx = {n: i for i, n in enumerate(names)}
+            F, k = len(names), self.n_modes
+            S0 = np.array([self.frames[n][0] for n in names], float).reshape(F, 2)
+            D = np.array([self.frames[n][1] for n in names], float).reshape(F, 2, k)
+            RZ = np.array([self.frames[n][2] for n in names], float).reshape(F, k)
+            self._stacked = (names, idx, S0, D, RZ)
+            self._geo = self._bias = (None, None)
+        return self._stacked
+
+    def _geometry(self, q):
+        """Poses (F, 3), Jacobians (F, 3, ndof) and ``A s`` and ``A D`` of every frame at ``q``,
+        computed once per configuration (every joint asks for its frames at the same ``q``)."""
+        _, idx, S0, D, RZ = self._stack()
+        key = q.tobytes()
+        if self._geo[0] == key:
+            return self._geo[1]
+        xi = q[3:]
         c, sn = np.cos(q[2]), np.sin(q[2])
         A = np.array([[c, -sn], [sn, c]])
-        return A, s0 + D @ q[3:], D, rz
+        As = (S0 + D @ xi) @ A.T
+        AD = np.einsum("ij,fjk->fik", A, D)
+        F = len(S0)
+        pose = np.empty((F, 3))
+        pose[:, :2] = q[:2] + As
+        pose[:, 2] = q[2] + RZ @ xi
+        J = np.zeros((F, 3, self.ndof))
+        J[:, 0, 0] = J[:, 1, 1] = J[:, 2, 2] = 1.0
+        J[:, 0, 2], J[:, 1, 2] = -As[:, 1], As[:, 0]
+        J[:, :2, 3:] = AD
+        J[:, 2, 3:] = RZ
+        out = (idx, pose, J, As, AD)
+        self._geo = (key, out)
+        return out
 
     def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray:
         """Pose ``(x, y, phi)`` of an interface node in the global plane, m and rad."""
-        A, s, _, rz = self._local(q, frame)
-        p = q[:2] + A @ s
-        return np.array([p[0], p[1], q[2] + rz @ q[3:]])
+        idx, pose, *_ = self._geometry(q)
+        return pose[idx[frame]].copy()
 
     def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray:
         """d(pose)/dq, shape (3, 3 + k)."""
-        A, s, D, rz = self._local(q, frame)
-        J = np.zeros((3, self.ndof))
-        J[0, 0] = J[1, 1] = J[2, 2] = 1.0
-        As = A @ s
-        J[0, 2], J[1, 2] = -As[1], As[0]
-        J[:2, 3:] = A @ D
-        J[2, 3:] = rz
-        return J
+        idx, _, J, *_ = self._geometry(q)
+        return J[idx[frame]].copy()
 
     def frame_bias(self, q: np.ndarray, qd: np.ndarray, frame: str) -> np.ndarray:
         """``Jdot qdot``: centripetal ``−θ̇² A s`` and Coriolis ``2 θ̇ Ω A D ξ̇``, m/s²."""
-        A, s, D, _ = self._local(q, frame)
-        w = qd[2]
-        a = -w * w * (A @ s) + 2.0 * w * (_OMEGA @ (A @ (D @ qd[3:])))
-        return np.array([a[0], a[1], 0.0])
+        idx, _, _, As, AD = self._geometry(q)
+        key = q.tobytes() + qd.tobytes()
+        if self._bias[0] != key:
+            w = qd[2]
+            v = AD @ qd[3:]  # (F, 2)
+            a = np.zeros((len(As), 3))
+            a[:, 0] = -w * w * As[:, 0] - 2.0 * w * v[:, 1]
+            a[:, 1] = -w * w * As[:, 1] + 2.0 * w * v[:, 0]
+            self._bias = (key, a)
+        return self._bias[1][idx[frame]].copy()
 
     def left_out(self) -> dict:
         """What the plane drops: per kept mode the out-of-plane share of its modal mass

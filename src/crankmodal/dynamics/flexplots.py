@@ -41,8 +41,8 @@ def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
     n = 2 + len(joints)
     fig, ax = plt.subplots(n, 1, figsize=(9, 2.6 * n))
     last = _last_revolution(hist, sel)
-    deg = np.rad2deg(np.unwrap(hist.crank_angle[last]))
-    deg = deg - 360.0 * np.floor(deg[0] / 360.0)
+    ang = np.unwrap(hist.crank_angle[last])
+    deg = np.rad2deg(np.abs(ang - ang[0]))  # turned since the last revolution began
     series = [("main bearing (sum)", hist.main_bearing_force,
                None if rigid is None else rigid.main_bearing_force)]
     series += [(f"journal {j}", hist.joint_forces[j],
@@ -51,7 +51,7 @@ def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
         a.plot(deg, np.hypot(*f[last].T) / 1e3, lw=1.2, label="flexible")
         if fr is not None:
             a.plot(deg, np.hypot(*fr[last].T) / 1e3, "k--", lw=1.0, label="rigid twin")
-        a.set(xlabel="crank angle [deg]", ylabel="|F| [kN]", title=label)
+        a.set(xlabel="crank angle in the last revolution [deg]", ylabel="|F| [kN]", title=label)
         a.grid(alpha=0.3)
         a.legend(loc="upper right", fontsize=8)
     orders = np.arange(13)
