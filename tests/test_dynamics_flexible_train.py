@@ -174,3 +174,72 @@ def test_slow_crank_under_a_constant_piston_load_deflects_the_rod_as_the_static_
     ref = _rod_static_fe_shortening(F / np.cos(beta))
     assert ref > 1e-6
     assert shortening == pytest.approx(ref, rel=1e-3)
+
+
+def _flex_scene(tmp_path, crank=None, rods=None):
+    from crankmodal.dynamics.flexbuild import flexbody_cache_dir  # noqa: F401 (the cache dir)
+
+    lines = ['name = "flex_bad"', "[mechanism]", 'machine = "four_star_compressor"',
+             "[dynamics]", 'machine = "four_star_compressor"', "clearances = []",
+             "end_time = 0.001", "ramp_time = 0.0", "[dynamics.flexible]"]
+    for key, spec in (("crank", crank), ("rods", rods)):
+        if spec is not None:
+            items = ", ".join(f"{k} = {v!r}".replace("'", '"') for k, v in spec.items())
+            lines.append(f"{key} = {{ {items} }}")
+    path = tmp_path / "scene.toml"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("case, match", [
+    ("other_npz", "dynamics.flexible.crank: .*not a crankmodal-flexbody"),
+    ("version", "dynamics.flexible.crank: .*version 2"),
+    ("missing", "dynamics.flexible.crank.file: no file"),
+    ("too_many", "dynamics.flexible.crank: .*n_modes = 99"),
+    ("damping", "dynamics.flexible.rods.damping_ratio"),
+    ("no_journal", "dynamics.flexible.crank.file: .*needs main_journal_"),
+    ("rod_length", "dynamics.flexible.rods.file: .*rod length is 0.392"),
+    ("unknown", "dynamics.flexible.rods.n_mode"),
+])
+def test_bad_flexible_input_exits_2_with_one_line_naming_the_key(parts, tmp_path, case, match):
+    """Every bad flexible-body input through `crankmodal run`: exit 2, one line naming the
+    key, and no results.json written."""
+    import re
+
+    from conftest import run_in_process
+
+    crank_ok = {"file": str(parts.crank), "n_modes": 2}
+    rods_ok = {"file": str(parts.rod), "n_modes": 1}
+    bad = tmp_path / "bad.npz"
+    if case == "other_npz":
+        np.savez(bad, a=np.zeros(3))
+        crank, rods = {"file": str(bad)}, None
+    elif case == "version":
+        z = dict(np.load(parts.crank))
+        z["version"] = np.array(2)
+        np.savez(bad, **z)
+        crank, rods = {"file": str(bad)}, None
+    elif case == "missing":
+        crank, rods = {"file": str(tmp_path / "nothing.npz")}, None
+    elif case == "too_many":
+        crank, rods = dict(crank_ok, n_modes=99), None
+    elif case == "damping":
+        crank, rods = None, dict(rods_ok, damping_ratio=-0.1)
+    elif case == "no_journal":
+        crank, rods = {"file": str(parts.rod)}, None
+    elif case == "rod_length":
+        z = dict(np.load(parts.rod))
+        c = z["interface_centres"].copy()
+        c[1, 0] *= 1.2  # the small end 20 % further out
+        z["interface_centres"] = c
+        np.savez(bad, **z)
+        crank, rods = None, {"file": str(bad)}
+    else:
+        crank, rods = None, {"file": str(parts.rod), "n_mode": 1}
+    out = tmp_path / "out"
+    status, err = run_in_process("run", _flex_scene(tmp_path, crank, rods), "--out", out)
+    lines = [ln for ln in err.strip().splitlines() if ln.strip() and not ln.startswith("[")]
+    assert status == 2, err
+    assert len(lines) == 1 and re.search(match, lines[0]), err  # only stage progress besides
+    assert "Traceback" not in err
+    assert not (out / "results.json").exists()

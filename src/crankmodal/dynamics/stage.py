@@ -28,6 +28,7 @@ def validate(raw: dict, scene) -> dict:
             if not path.is_file():
                 raise SceneError(f"dynamics.flexible.{key}.file: no file {str(path)!r}")
             spec["file"] = str(path)
+            _probe_flexbody(key, spec)
     if p["from_mechanism"] and (scene is None or "mechanism" not in scene.sections):
         raise SceneError("dynamics.from_mechanism: needs a [mechanism] section in the scene")
     if p["speed_rpm"] is not None:
@@ -37,6 +38,18 @@ def validate(raw: dict, scene) -> dict:
         if isinstance(speed, (int, float)) and not isinstance(speed, bool):
             check_speed(p, speed, "mechanism.speed_rpm")
     return p
+
+
+def _probe_flexbody(key: str, spec: dict) -> None:
+    """Read a given flexbody file before any stage runs: format, version, modes asked."""
+    from ..errors import InputFileError, SceneError
+    from .flexible import load_flexible_body
+
+    try:
+        load_flexible_body(spec["file"], key, n_modes=spec["n_modes"], cutoff_hz=spec["cutoff_hz"],
+                           damping_ratio=spec["damping_ratio"])
+    except (SceneError, InputFileError) as exc:
+        raise type(exc)(f"dynamics.flexible.{key}: {exc}") from None
 
 
 def short_contact_warning(cj, duration: float, dt: float) -> str:
