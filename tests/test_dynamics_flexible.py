@@ -240,3 +240,11 @@ def test_cutoff_selects_in_plane_modes_and_reports_what_the_plane_drops(reduced)
     assert lo["not_offered"][0]["hz"] < flex.frequencies_hz[0]
     assert lo["not_offered"][0]["in_plane_share"] < 0.05
     assert isinstance(flex, FlexibleBody) and N_AUX == 6
+
+
+def test_rigid_and_flexible_bodies_implement_the_body_protocol(reduced):
+    from crankmodal.dynamics.bodies import Body
+
+    flex = load_flexible_body(reduced.path, "bar", n_modes=2)
+    assert isinstance(flex, Body) and isinstance(RigidBody("r", 1.0, 1.0), Body)
+    assert not isinstance(Ground(), Body)  # no coordinates: referenced by joints only

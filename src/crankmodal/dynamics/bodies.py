@@ -9,8 +9,44 @@ rigid planar body has coordinates ``(x, y, theta)`` of its centre of mass; a lat
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
 
 import numpy as np
+
+
+@runtime_checkable
+class Body(Protocol):
+    """What every body gives the dynamics core (SI units; ``q`` and ``qd`` are the body's own
+    coordinates and velocities, the first three ``(x, y, θ)`` of its reference frame).
+
+    Joints, clearance joints, drives and loads see only interface frames (``frame_pose``,
+    ``frame_jacobian``, ``frame_bias``); :class:`~.system.Multibody` assembles the rest. A body
+    with elastic coordinates (:class:`~.flexible.FlexibleBody`) adds ``internal_forces`` (elastic
+    and damping forces, moved to the left side), ``strain_energy`` and ``damping_power``.
+    """
+
+    name: str
+    ndof: int
+    frames: dict
+    z: float
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray: ...
+
+    def velocity_forces(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray: ...
+
+    def gravity_force(self, q: np.ndarray, g: np.ndarray) -> np.ndarray: ...
+
+    def potential_energy(self, q: np.ndarray, g: np.ndarray) -> float: ...
+
+    def kinetic_energy(self, q: np.ndarray, qd: np.ndarray) -> float: ...
+
+    def local(self, frame: str) -> tuple[np.ndarray, float]: ...
+
+    def frame_pose(self, q: np.ndarray, frame: str) -> np.ndarray: ...
+
+    def frame_jacobian(self, q: np.ndarray, frame: str) -> np.ndarray: ...
+
+    def frame_bias(self, q: np.ndarray, qd: np.ndarray, frame: str) -> np.ndarray: ...
 
 
 @dataclass
