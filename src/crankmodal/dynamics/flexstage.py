@@ -135,13 +135,6 @@ def interface_deflections(body, modal) -> dict:
     return out
 
 
-def von_mises(s) -> np.ndarray:
-    """Von Mises stress of Voigt stresses ``(…, 6)`` (xx yy zz yz xz xy), Pa."""
-    xx, yy, zz, yz, xz, xy = np.moveaxis(s, -1, 0)
-    return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2)
-                   + 3.0 * (yz ** 2 + xz ** 2 + xy ** 2))
-
-
 def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict | None:
     """Largest von Mises stress of a flexible body over a run, from its stress modes.
 
@@ -150,6 +143,7 @@ def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict 
     holds no stress modes.
     """
     from ..reduction.io import load_flexbody
+    from ..reduction.stress_modes import von_mises
 
     fb = load_flexbody(body.info["file"])
     modes = getattr(fb, "stress_modes", None)
@@ -162,7 +156,7 @@ def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict 
     when = np.zeros(S.shape[0], int)
     for k0 in range(0, len(t), STRESS_CHUNK):
         sig = np.einsum("pik,tk->tpi", S, xi[k0:k0 + STRESS_CHUNK])
-        vm = von_mises(sig)
+        vm = von_mises(sig, axis=-1)
         i = np.argmax(vm, axis=0)
         v = vm[i, np.arange(vm.shape[1])]
         better = v > best
@@ -216,4 +210,4 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
 
 
 __all__ = ["dynamic_stress", "flexible_results", "force_comparison", "interface_deflections",
-           "make_bodies", "rigid_twins", "train_geometry", "von_mises"]
+           "make_bodies", "rigid_twins", "train_geometry"]
