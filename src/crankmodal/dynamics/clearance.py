@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import contact
+from . import laws
 from .lubrication import short_bearing_film
 
 FILM_MODELS = ("short", "finite")
@@ -35,14 +35,19 @@ class ClearanceJoint:
         Radial clearance ``c = R_bearing - R_journal``, m.
     journal_radius : float
         m (lever arm of friction).
-    law : str
-        Normal force law, one of :data:`contact.NORMAL_LAWS`.
+    law : NormalLaw or str
+        Normal force law: an object of :mod:`.laws`, or its name (one of
+        :data:`contact.NORMAL_LAWS`) with ``law_params``. After construction ``law`` is the
+        name and ``normal`` the law object.
     law_params : dict
-        Parameters of the law (see :func:`contact.normal_force`).
-    friction : str
-        One of :data:`contact.FRICTION_LAWS`.
+        Parameters of a law given by name (see :func:`.laws.make_law`); with a law object, set
+        from it.
+    friction : FrictionLaw or str
+        Friction law: an object of :mod:`.laws`, or its name (one of
+        :data:`contact.FRICTION_LAWS`) with ``friction_params``. After construction
+        ``friction`` is the name and ``friction_law`` the object.
     friction_params : dict
-        ``mu_static, mu_dynamic, v_static, v_dynamic`` (m/s).
+        ``mu_static, mu_dynamic, v_static, v_dynamic`` (m/s) of a law given by name.
     v_impact_min : float
         Floor of the impact velocity used by restitution laws, m/s: a contact that starts at
         (almost) zero approach speed would otherwise get unbounded damping.
@@ -72,9 +77,9 @@ class ClearanceJoint:
     bearing_frame: str
     clearance: float
     journal_radius: float
-    law: str = "impact"
+    law: str | laws.NormalLaw = "impact"
     law_params: dict = field(default_factory=dict)
-    friction: str = "none"
+    friction: str | laws.FrictionLaw = "none"
     friction_params: dict = field(default_factory=dict)
     v_impact_min: float = 1e-3
     clearance_major: float | None = None
@@ -85,10 +90,12 @@ class ClearanceJoint:
     eps_max: float = 0.95
     # contact memory (restitution laws): impact velocity of the current contact
     v_impact: float = 1e-3
+    normal: laws.NormalLaw = field(init=False, repr=False)
+    friction_law: laws.FrictionLaw = field(init=False, repr=False)
 
     @property
     def needs_memory(self) -> bool:
-        return self.law in contact.RESTITUTION_LAWS
+        return self.normal.needs_impact_velocity
 
     def kinematics(self, sysm, q, qd):
         """Eccentricity, penetration, penetration rate, slip velocity, and the frame data."""
@@ -131,6 +138,16 @@ class ClearanceJoint:
     def __post_init__(self):
         if self.film_model not in FILM_MODELS:
             raise ValueError(f"film_model must be one of {FILM_MODELS}; got {self.film_model!r}")
+        if isinstance(self.law, laws.NormalLaw):
+            self.normal = self.law
+            self.law, self.law_params = self.normal.name, self.normal.params()
+        else:
+            self.normal = laws.make_law(self.law, self.law_params)
+        if isinstance(self.friction, laws.FrictionLaw):
+            self.friction_law = self.friction
+            self.friction, self.friction_params = self.friction_law.name, self.friction_law.params()
+        else:
+            self.friction_law = laws.make_friction(self.friction, self.friction_params)
 
     def film_force(self, k) -> np.ndarray:
         """Film force on the journal (global x, y), N (``film_model``: short or finite)."""
@@ -164,11 +181,10 @@ class ClearanceJoint:
         k = self.kinematics(sysm, q, qd)
         delta, ddot = k["delta"], k["delta_dot"]
         if delta > 0.0:
-            fn = float(contact.normal_force(self.law, delta, ddot, self.law_params,
-                                            max(self.v_impact, self.v_impact_min)))
-            fel = float(contact.elastic_force(self.law, delta, self.law_params))
-            mu = float(contact.friction_coefficient(self.friction, k["v_slip"],
-                                                    self.friction_params))
+            law = self.normal
+            fn = float(law.force(delta, ddot, max(self.v_impact, self.v_impact_min)))
+            fel = float(law.elastic_force(delta))
+            mu = float(self.friction_law.coefficient(k["v_slip"]))
         else:
             fn = fel = mu = 0.0
         ft = -mu * fn
@@ -187,5 +203,5 @@ class ClearanceJoint:
                                  np.array([-f[0], -f[1], -k["r_b"] * ft - fn * k["dtheta"]]))
         k.update(fn=fn, ft=ft, force=f, film=float(np.hypot(*f_film)),
                  p_damp=(fn - fel) * ddot - p_film, p_fric=-ft * k["v_slip"],
-                 v_elastic=float(contact.elastic_energy(self.law, delta, self.law_params)))
+                 v_elastic=float(self.normal.elastic_energy(delta)))
         return k

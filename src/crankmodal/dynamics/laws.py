@@ -1,0 +1,393 @@
+"""Normal contact and friction laws as objects: one class per law, its parameters as fields.
+
+Each normal law is a frozen dataclass whose constructor validates its parameters (``ValueError``
+naming the parameter) and whose methods call the pure functions of :mod:`.contact`:
+
+``force(delta, delta_dot, v_impact)``
+    Normal force, N (compressive positive, 0 outside contact; conventions of :mod:`.contact`).
+``elastic_force(delta)``, ``elastic_energy(delta)``
+    The conservative part of the law, N, and its potential, J.
+
+Laws whose damping depends on the impact velocity have ``needs_impact_velocity = True``. A
+friction law has ``coefficient(v)``: the signed coefficient at slip velocity ``v`` (m/s), the
+friction force being ``-mu F_n``.
+
+Each law also carries ``code`` and ``vector()``: an integer and a float vector that the compiled
+right-hand side of :mod:`.compiled` evaluates (the same arithmetic, in machine code).
+
+Registries: :data:`LAWS` and :data:`FRICTION` (name -> class); :func:`make_law` and
+:func:`make_friction` build a law from a name and a parameter mapping (the ``law_params`` /
+``friction_params`` dictionaries of the scene dialect; keys a law does not use are ignored) and
+``law.params()`` gives such a dictionary back.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import MISSING, asdict, dataclass, fields
+from typing import ClassVar
+
+import numpy as np
+
+from . import contact
+
+
+def _positive(name: str, value) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v > 0.0):
+        raise ValueError(f"{name} must be a finite number > 0; got {value!r}")
+    return v
+
+
+def _non_negative(name: str, value) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ValueError(f"{name} must be a finite number >= 0; got {value!r}")
+    return v
+
+
+def _restitution(value) -> float:
+    v = float(value)
+    if not (0.0 < v <= 1.0):
+        raise ValueError(f"restitution must be in (0, 1]; got {value!r}")
+    return v
+
+
+# ---------------------------------------------------------------------------------- normal laws
+@dataclass(frozen=True)
+class NormalLaw:
+    """Base of the normal force laws (see the module docstring)."""
+
+    name: ClassVar[str] = ""
+    code: ClassVar[int] = -1
+    needs_impact_velocity: ClassVar[bool] = False
+
+    def params(self) -> dict:
+        """The parameters as a ``law_params`` dictionary."""
+        return asdict(self)
+
+    def force(self, delta, delta_dot, v_impact=1.0):
+        raise NotImplementedError
+
+    def elastic_force(self, delta):
+        """``K delta**n`` (``n = 1`` for kelvin_voigt), N."""
+        return self.stiffness * contact._pos(delta) ** self.elastic_exponent
+
+    def elastic_energy(self, delta):
+        """``K delta**(n+1) / (n+1)``, J."""
+        n = self.elastic_exponent
+        return self.stiffness * contact._pos(delta) ** (n + 1.0) / (n + 1.0)
+
+    @property
+    def elastic_exponent(self) -> float:
+        return self.exponent
+
+    def vector(self) -> np.ndarray:
+        """Parameters for the compiled kernel: ``[K, n, c, d_or_e, dR]`` (unused entries 0)."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Hertz(NormalLaw):
+    """``K delta**n``, no dissipation. ``stiffness`` K in N/m**n, ``exponent`` n."""
+
+    stiffness: float
+    exponent: float = 1.5
+    name: ClassVar[str] = "hertz"
+    code: ClassVar[int] = 0
+
+    def __post_init__(self):
+        object.__setattr__(self, "stiffness", _positive("stiffness", self.stiffness))
+        object.__setattr__(self, "exponent", _positive("exponent", self.exponent))
+
+    def force(self, delta, delta_dot=0.0, v_impact=1.0):
+        return contact.hertz(delta, self.stiffness, self.exponent)
+
+    def vector(self):
+        return np.array([self.stiffness, self.exponent, 0.0, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class KelvinVoigt(NormalLaw):
+    """Linear spring-dashpot ``K delta + c delta_dot``: ``stiffness`` N/m, ``damping`` N s/m."""
+
+    stiffness: float
+    damping: float
+    name: ClassVar[str] = "kelvin_voigt"
+    code: ClassVar[int] = 1
+
+    def __post_init__(self):
+        object.__setattr__(self, "stiffness", _positive("stiffness", self.stiffness))
+        object.__setattr__(self, "damping", _non_negative("damping", self.damping))
+
+    elastic_exponent: ClassVar[float] = 1.0
+
+    def force(self, delta, delta_dot, v_impact=1.0):
+        return contact.kelvin_voigt(delta, delta_dot, self.stiffness, self.damping)
+
+    def vector(self):
+        return np.array([self.stiffness, 1.0, self.damping, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class PowerDamped(NormalLaw):
+    """``K delta**n + c delta_dot``: ``stiffness`` N/m**n, ``exponent``, ``damping`` N s/m."""
+
+    stiffness: float
+    damping: float
+    exponent: float = 1.5
+    name: ClassVar[str] = "power_damped"
+    code: ClassVar[int] = 2
+
+    def __post_init__(self):
+        object.__setattr__(self, "stiffness", _positive("stiffness", self.stiffness))
+        object.__setattr__(self, "exponent", _positive("exponent", self.exponent))
+        object.__setattr__(self, "damping", _non_negative("damping", self.damping))
+
+    def force(self, delta, delta_dot, v_impact=1.0):
+        return contact.power_damped(delta, delta_dot, self.stiffness, self.exponent, self.damping)
+
+    def vector(self):
+        return np.array([self.stiffness, self.exponent, self.damping, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class Impact(NormalLaw):
+    """ADAMS IMPACT ``K delta**n + STEP(delta, 0, 0, d_max, c_max) delta_dot``.
+
+    ``stiffness`` N/m**n, ``exponent``, ``damping`` c_max in N s/m, ``penetration`` d_max in m.
+    """
+
+    stiffness: float
+    damping: float
+    penetration: float
+    exponent: float = 1.5
+    name: ClassVar[str] = "impact"
+    code: ClassVar[int] = 3
+
+    def __post_init__(self):
+        object.__setattr__(self, "stiffness", _positive("stiffness", self.stiffness))
+        object.__setattr__(self, "exponent", _positive("exponent", self.exponent))
+        object.__setattr__(self, "damping", _non_negative("damping", self.damping))
+        object.__setattr__(self, "penetration", _positive("penetration", self.penetration))
+
+    def force(self, delta, delta_dot, v_impact=1.0):
+        return contact.impact(delta, delta_dot, self.stiffness, self.exponent, self.damping,
+                              self.penetration)
+
+    def vector(self):
+        return np.array([self.stiffness, self.exponent, self.damping, self.penetration, 0.0])
+
+
+@dataclass(frozen=True)
+class _Hysteresis(NormalLaw):
+    """``K delta**n (1 + chi(e, v_impact) delta_dot)``: ``stiffness``, ``exponent``,
+    ``restitution`` e in (0, 1]."""
+
+    stiffness: float
+    restitution: float
+    exponent: float = 1.5
+    needs_impact_velocity: ClassVar[bool] = True
+
+    def __post_init__(self):
+        object.__setattr__(self, "stiffness", _positive("stiffness", self.stiffness))
+        object.__setattr__(self, "exponent", _positive("exponent", self.exponent))
+        object.__setattr__(self, "restitution", _restitution(self.restitution))
+
+    def hysteresis_factor(self, v_impact):
+        """``chi`` in s/m at impact velocity ``v_impact`` (m/s)."""
+        return contact.hysteresis_factor(self.name, self.restitution, v_impact)
+
+    def force(self, delta, delta_dot, v_impact=1.0):
+        return contact.hysteresis(delta, delta_dot, self.stiffness, self.exponent,
+                                  self.hysteresis_factor(v_impact))
+
+    def vector(self):
+        return np.array([self.stiffness, self.exponent, 0.0, self.restitution, 0.0])
+
+
+@dataclass(frozen=True)
+class HuntCrossley(_Hysteresis):
+    """Hunt & Crossley (1975): ``chi = 3 (1 - e) / (2 v)``."""
+
+    name: ClassVar[str] = "hunt_crossley"
+    code: ClassVar[int] = 4
+
+
+@dataclass(frozen=True)
+class LankaraniNikravesh(_Hysteresis):
+    """Lankarani & Nikravesh (1990): ``chi = 3 (1 - e**2) / (4 v)``."""
+
+    name: ClassVar[str] = "lankarani_nikravesh"
+    code: ClassVar[int] = 5
+
+
+@dataclass(frozen=True)
+class Flores(_Hysteresis):
+    """Flores et al. (2011): ``chi = 8 (1 - e) / (5 e v)``."""
+
+    name: ClassVar[str] = "flores"
+    code: ClassVar[int] = 6
+
+
+@dataclass(frozen=True)
+class JohnsonCylinder(NormalLaw):
+    """Johnson's conformal-cylinder force with Lankarani-Nikravesh damping.
+
+    ``stiffness`` pi L E* in N/m, ``radial_clearance`` dR in m, ``restitution`` e in (0, 1]
+    (see :func:`.contact.johnson_cylinder_force`).
+    """
+
+    stiffness: float
+    radial_clearance: float
+    restitution: float
+    name: ClassVar[str] = "johnson_cylinder"
+    code: ClassVar[int] = 7
+    needs_impact_velocity: ClassVar[bool] = True
+
+    def __post_init__(self):
+        object.__setattr__(self, "stiffness", _positive("stiffness", self.stiffness))
+        object.__setattr__(self, "radial_clearance",
+                           _positive("radial_clearance", self.radial_clearance))
+        object.__setattr__(self, "restitution", _restitution(self.restitution))
+
+    def force(self, delta, delta_dot, v_impact=1.0):
+        chi = contact.hysteresis_factor(self.name, self.restitution, v_impact)
+        f = contact.johnson_cylinder_force(delta, self.stiffness, self.radial_clearance)
+        return np.where(np.asarray(delta, float) > 0.0,
+                        np.maximum(f * (1.0 + chi * np.asarray(delta_dot, float)), 0.0), 0.0)
+
+    def elastic_force(self, delta):
+        return contact.johnson_cylinder_force(delta, self.stiffness, self.radial_clearance)
+
+    def elastic_energy(self, delta):
+        return contact.johnson_cylinder_energy(delta, self.stiffness, self.radial_clearance)
+
+    def vector(self):
+        return np.array([self.stiffness, 1.0, 0.0, self.restitution, self.radial_clearance])
+
+
+#: normal force laws by name
+LAWS: dict[str, type[NormalLaw]] = {c.name: c for c in (
+    Hertz, KelvinVoigt, PowerDamped, Impact, HuntCrossley, LankaraniNikravesh, Flores,
+    JohnsonCylinder)}
+
+
+def _build(registry, kind, name, params):
+    try:
+        cls = registry[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"unknown {kind} law {name!r}; known: {', '.join(registry)}") from None
+    params = dict(params or {})
+    kw = {}
+    for f in fields(cls):
+        if f.name in params and params[f.name] is not None:
+            kw[f.name] = params[f.name]
+    missing = [f.name for f in fields(cls) if f.name not in kw and f.default is MISSING]
+    if missing:
+        raise ValueError(f"{kind} law {name!r} needs parameter {missing[0]!r}")
+    return cls(**kw)
+
+
+def make_law(name: str, params=None) -> NormalLaw:
+    """A normal law from its name and a ``law_params`` mapping (unused keys ignored).
+
+    Raises
+    ------
+    ValueError
+        Unknown name, a missing parameter, or an invalid value (naming it).
+    """
+    return _build(LAWS, "normal force", name, params)
+
+
+# ---------------------------------------------------------------------------------- friction
+@dataclass(frozen=True)
+class FrictionLaw:
+    """Base of the friction laws: ``coefficient(v)`` signed like the slip velocity ``v``."""
+
+    name: ClassVar[str] = ""
+    code: ClassVar[int] = -1
+
+    def params(self) -> dict:
+        return asdict(self)
+
+    def coefficient(self, v):
+        raise NotImplementedError
+
+    def vector(self) -> np.ndarray:
+        """``[mu_s, mu_d, v_s, v_d]`` for the compiled kernel (unused entries 0)."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class NoFriction(FrictionLaw):
+    """Frictionless contact."""
+
+    name: ClassVar[str] = "none"
+    code: ClassVar[int] = 0
+
+    def coefficient(self, v):
+        return np.zeros_like(np.asarray(v, float))
+
+    def vector(self):
+        return np.zeros(4)
+
+
+@dataclass(frozen=True)
+class Coulomb(FrictionLaw):
+    """Coulomb friction with a static/dynamic transition (ADAMS style).
+
+    ``mu_static``, ``mu_dynamic``; ``v_static`` and ``v_dynamic`` (m/s): see :func:`.contact.coulomb_coefficient`.
+    """
+
+    mu_static: float
+    mu_dynamic: float
+    v_static: float
+    v_dynamic: float
+    name: ClassVar[str] = "coulomb"
+    code: ClassVar[int] = 1
+
+    def __post_init__(self):
+        for k in ("mu_static", "mu_dynamic"):
+            object.__setattr__(self, k, _non_negative(k, getattr(self, k)))
+        for k in ("v_static", "v_dynamic"):
+            object.__setattr__(self, k, _positive(k, getattr(self, k)))
+
+    def coefficient(self, v):
+        return contact.coulomb_coefficient(v, self.mu_static, self.mu_dynamic, self.v_static,
+                                           self.v_dynamic)
+
+    def vector(self):
+        return np.array([self.mu_static, self.mu_dynamic, self.v_static, self.v_dynamic])
+
+
+@dataclass(frozen=True)
+class Ambrosio(FrictionLaw):
+    """Ambrosio's modified Coulomb law ``mu_dynamic c_d(v)``, ``c_d`` linear from 0 at
+    ``v_static`` to 1 at ``v_dynamic`` (m/s)."""
+
+    mu_dynamic: float
+    v_static: float
+    v_dynamic: float
+    name: ClassVar[str] = "ambrosio"
+    code: ClassVar[int] = 2
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu_dynamic", _non_negative("mu_dynamic", self.mu_dynamic))
+        for k in ("v_static", "v_dynamic"):
+            object.__setattr__(self, k, _positive(k, getattr(self, k)))
+
+    def coefficient(self, v):
+        return contact.ambrosio_coefficient(v, self.mu_dynamic, self.v_static, self.v_dynamic)
+
+    def vector(self):
+        return np.array([0.0, self.mu_dynamic, self.v_static, self.v_dynamic])
+
+
+#: friction laws by name
+FRICTION: dict[str, type[FrictionLaw]] = {c.name: c for c in (NoFriction, Coulomb, Ambrosio)}
+
+
+def make_friction(name: str, params=None) -> FrictionLaw:
+    """A friction law from its name and a ``friction_params`` mapping (unused keys ignored)."""
+    return _build(FRICTION, "friction", name, params)
