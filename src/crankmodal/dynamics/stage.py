@@ -40,6 +40,26 @@ def validate(raw: dict, scene) -> dict:
     return p
 
 
+def _start_warning(mech, p, rev_hz) -> str | None:
+    """A flexible run started at full speed: the undeformed bodies ring through their modes."""
+    slow = None
+    for b in mech.system.bodies:
+        k = getattr(b, "n_elastic", 0)
+        if k:
+            w, z = 2 * np.pi * b.frequencies_hz[:k], b.zeta[:k]
+            t = float(np.max(5.0 / np.maximum(z * w, 1e-300)))  # e^-5 of every kept mode
+            slow = t if slow is None else max(slow, t)
+    if slow is None:
+        return None
+    t0 = p["spectrum_start"] if p["spectrum_start"] is not None else 1.0 / rev_hz
+    if slow <= t0:
+        return None
+    return (f"dynamics.ramp_time: the flexible bodies start undeformed at full speed; the "
+            f"start-up rings through their modes and decays to e^-5 only after {slow:.3g} s "
+            f"(modal damping), after the results window opens at {t0:.3g} s; give a ramp "
+            f"(e.g. ramp_time = 0.1) or a later spectrum_start")
+
+
 def _probe_flexbody(key: str, spec: dict) -> None:
     """Read a given flexbody file before any stage runs: format, version, modes asked."""
     from ..errors import InputFileError, SceneError
@@ -119,6 +139,10 @@ def run(params: dict, ctx) -> dict:
     early_warnings = []
     for text in timescales.check_budget(scales, t_end, settings.method, settings.max_rhs_evals):
         warn(text, into=early_warnings)
+    if bodies is not None and p["ramp_time"] == 0.0:
+        text = _start_warning(mech, p, rev_hz)
+        if text:
+            warn(text, into=early_warnings)
     tol = p["energy_tolerance"]
     hist = simulate(mech, t_end, dt, settings, energy_tolerance=tol)
     ideal = None
