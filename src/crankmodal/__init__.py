@@ -4,8 +4,14 @@ Stages (one subpackage each) hand plain data to each other:
 parameters -> geometry -> mesh -> matrices -> modes -> reduced body -> dynamics -> report.
 Heavy dependencies (gmsh, scikit-fem, pyvista) are imported inside the stage that uses them,
 so ``import crankmodal`` stays light.
+
+The public Python API is importable from the package itself (``from crankmodal import Part,
+assemble, solve_modes``). The names are resolved lazily (PEP 562 module ``__getattr__``): each
+is imported from its home module on first access, so ``import crankmodal`` loads none of
+gmsh, scikit-fem, pyvista or matplotlib. The README's "Python API" section shows every stage.
 """
 
+from importlib import import_module
 from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as _version
 
@@ -14,4 +20,183 @@ try:
 except PackageNotFoundError:  # running from a source tree without install
     __version__ = "0.0.0+local"
 
-__all__ = ["__version__"]
+#: public name -> (home module, attribute there). Grouped by stage, in data-flow order.
+_EXPORTS: dict[str, tuple[str, str]] = {
+    # scenes and the runner (what the CLI does, from Python)
+    "Scene": ("crankmodal.scene", "Scene"),
+    "load_scene": ("crankmodal.scene", "load_scene"),
+    "scene_from_dict": ("crankmodal.scene", "scene_from_dict"),
+    "check_scene": ("crankmodal.runner", "check"),
+    "run_scene": ("crankmodal.runner", "run"),
+    "list_machines": ("crankmodal.resources", "list_machines"),
+    "load_machine": ("crankmodal.resources", "load_machine"),
+    # errors
+    "CrankmodalError": ("crankmodal.errors", "CrankmodalError"),
+    "SceneError": ("crankmodal.errors", "SceneError"),
+    "InputFileError": ("crankmodal.errors", "InputFileError"),
+    "OutputError": ("crankmodal.errors", "OutputError"),
+    "GeometryError": ("crankmodal.errors", "GeometryError"),
+    "NumericalError": ("crankmodal.errors", "NumericalError"),
+    # geometry -> Part
+    "Part": ("crankmodal.part", "Part"),
+    "Region": ("crankmodal.part", "Region"),
+    "MassProperties": ("crankmodal.part", "MassProperties"),
+    "CrankshaftParams": ("crankmodal.geometry.params", "CrankshaftParams"),
+    "ConrodParams": ("crankmodal.geometry.params", "ConrodParams"),
+    "params_from_dict": ("crankmodal.geometry.params", "params_from_dict"),
+    "MeshSettings": ("crankmodal.geometry.mesh", "MeshSettings"),
+    "build_part": ("crankmodal.geometry.build", "build_part"),
+    "import_mesh": ("crankmodal.geometry.importers", "import_mesh"),
+    "import_cad": ("crankmodal.geometry.importers", "import_cad"),
+    # FE: material, model, supports, loads, modes, static
+    "Material": ("crankmodal.fem.materials", "Material"),
+    "material": ("crankmodal.fem.materials", "material"),
+    "FEModel": ("crankmodal.fem.assembly", "FEModel"),
+    "assemble": ("crankmodal.fem.assembly", "assemble"),
+    "mass_properties": ("crankmodal.fem.assembly", "mass_properties"),
+    "Support": ("crankmodal.fem.supports", "Support"),
+    "select_supports": ("crankmodal.fem.supports", "select"),
+    "pressure_load": ("crankmodal.fem.loads", "pressure_load"),
+    "traction_force": ("crankmodal.fem.loads", "traction_force"),
+    "remote_force": ("crankmodal.fem.loads", "remote_force"),
+    "bearing_load": ("crankmodal.fem.loads", "bearing_load"),
+    "Modes": ("crankmodal.fem.modal", "Modes"),
+    "solve_modes": ("crankmodal.fem.modal", "solve_modes"),
+    "StaticResult": ("crankmodal.fem.static", "StaticResult"),
+    "solve_static": ("crankmodal.fem.static", "solve_static"),
+    # reduction -> reduced body (.npz)
+    "Interface": ("crankmodal.reduction.interfaces", "Interface"),
+    "make_interfaces": ("crankmodal.reduction.interfaces", "make_interfaces"),
+    "reduce_body": ("crankmodal.reduction.reduce", "reduce_body"),
+    "ReducedBody": ("crankmodal.reduction.flexbody", "FlexibleBody"),
+    "save_flexbody": ("crankmodal.reduction.io", "save_flexbody"),
+    "load_flexbody": ("crankmodal.reduction.io", "load_flexbody"),
+    # torsion
+    "TorsionalChain": ("crankmodal.torsion.chain", "TorsionalChain"),
+    "ChainModes": ("crankmodal.torsion.chain", "ChainModes"),
+    "exact_modes": ("crankmodal.torsion.chain", "exact_modes"),
+    "HolzerResult": ("crankmodal.torsion.holzer", "HolzerResult"),
+    "holzer": ("crankmodal.torsion.holzer", "holzer"),
+    "TwoRotorResult": ("crankmodal.torsion.two_rotor", "TwoRotorResult"),
+    "two_rotor": ("crankmodal.torsion.two_rotor", "two_rotor"),
+    "reduce_to_two_rotors": ("crankmodal.torsion.two_rotor", "reduce_to_two_rotors"),
+    "CrankModel": ("crankmodal.torsion.crank_model", "CrankModel"),
+    "crank_model": ("crankmodal.torsion.crank_model", "crank_model"),
+    "CriticalSpeeds": ("crankmodal.torsion.critical_speeds", "CriticalSpeeds"),
+    "critical_speeds": ("crankmodal.torsion.critical_speeds", "critical_speeds"),
+    # dynamics: bodies, joints, systems, mechanisms, runs
+    "RigidBody": ("crankmodal.dynamics.bodies", "RigidBody"),
+    "Ground": ("crankmodal.dynamics.bodies", "Ground"),
+    "FlexibleBody": ("crankmodal.dynamics.flexible", "FlexibleBody"),
+    "load_flexible_body": ("crankmodal.dynamics.flexible", "load_flexible_body"),
+    "crank_body": ("crankmodal.dynamics.flexbuild", "crank_body"),
+    "rod_body": ("crankmodal.dynamics.flexbuild", "rod_body"),
+    "rigid_twin": ("crankmodal.dynamics.flexbuild", "rigid_twin"),
+    "Revolute": ("crankmodal.dynamics.joints", "Revolute"),
+    "Prismatic": ("crankmodal.dynamics.joints", "Prismatic"),
+    "ClearanceJoint": ("crankmodal.dynamics.clearance", "ClearanceJoint"),
+    "Multibody": ("crankmodal.dynamics.system", "Multibody"),
+    "Cylinder": ("crankmodal.dynamics.mechanisms", "Cylinder"),
+    "Mechanism": ("crankmodal.dynamics.mechanisms", "Mechanism"),
+    "crank_train": ("crankmodal.dynamics.mechanisms", "crank_train"),
+    "four_bar": ("crankmodal.dynamics.mechanisms", "four_bar"),
+    "SolverSettings": ("crankmodal.dynamics.simulate", "SolverSettings"),
+    "integrate": ("crankmodal.dynamics.simulate", "integrate"),
+    "History": ("crankmodal.dynamics.history", "History"),
+    "simulate": ("crankmodal.dynamics.analysis", "simulate"),
+}
+
+# the same names as _EXPORTS (a literal list, for static tools); tests/test_api.py checks it
+__all__ = [
+    "ChainModes",
+    "ClearanceJoint",
+    "ConrodParams",
+    "CrankModel",
+    "CrankmodalError",
+    "CrankshaftParams",
+    "CriticalSpeeds",
+    "Cylinder",
+    "FEModel",
+    "FlexibleBody",
+    "GeometryError",
+    "Ground",
+    "History",
+    "HolzerResult",
+    "InputFileError",
+    "Interface",
+    "MassProperties",
+    "Material",
+    "Mechanism",
+    "MeshSettings",
+    "Modes",
+    "Multibody",
+    "NumericalError",
+    "OutputError",
+    "Part",
+    "Prismatic",
+    "ReducedBody",
+    "Region",
+    "Revolute",
+    "RigidBody",
+    "Scene",
+    "SceneError",
+    "SolverSettings",
+    "StaticResult",
+    "Support",
+    "TorsionalChain",
+    "TwoRotorResult",
+    "__version__",
+    "assemble",
+    "bearing_load",
+    "build_part",
+    "check_scene",
+    "crank_body",
+    "crank_model",
+    "crank_train",
+    "critical_speeds",
+    "exact_modes",
+    "four_bar",
+    "holzer",
+    "import_cad",
+    "import_mesh",
+    "integrate",
+    "list_machines",
+    "load_flexbody",
+    "load_flexible_body",
+    "load_machine",
+    "load_scene",
+    "make_interfaces",
+    "mass_properties",
+    "material",
+    "params_from_dict",
+    "pressure_load",
+    "reduce_body",
+    "reduce_to_two_rotors",
+    "remote_force",
+    "rigid_twin",
+    "rod_body",
+    "run_scene",
+    "save_flexbody",
+    "scene_from_dict",
+    "select_supports",
+    "simulate",
+    "solve_modes",
+    "solve_static",
+    "traction_force",
+    "two_rotor",
+]
+
+
+def __getattr__(name: str):
+    """Import a public name from its home module on first access (PEP 562)."""
+    try:
+        module, attr = _EXPORTS[name]
+    except KeyError:
+        raise AttributeError(f"module 'crankmodal' has no attribute {name!r}") from None
+    value = getattr(import_module(module), attr)
+    globals()[name] = value  # later accesses skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))
