@@ -6,6 +6,9 @@ Run the three scenes first, then this script::
     for v in crank rods both; do crankmodal run scenes/seed000_flexible_$v.toml --out OUT/$v; done
     python scenes/plot_seed000_flexible.py OUT docs/img/seed000_flexible.png
 
+``plot_seed000_flexible.py truncation OUT/sweep.csv PNG`` draws the modal-truncation study of
+``scenes/sweeps/seed000_flexible_truncation.toml`` (error against run time).
+
 Prints a Markdown table of the numbers (peak, RMS, the RMS of the flexible-minus-rigid
 difference, orders 1-3, the ripple above order 12, the dynamic stress) and writes the figure.
 """
@@ -93,5 +96,59 @@ def main(root: Path, figure: Path) -> None:
               f"{r['wall'][0]:.0f} / {r['wall'][1]:.0f} |")
 
 
+
+
+def truncation(csv_path: Path, figure: Path) -> None:
+    """Error against run time of the truncation sweep (``seed000_flexible_truncation.toml``):
+    each output's relative change from the most modes at the tightest tolerance."""
+    import csv
+
+    from crankmodal.plotting import pyplot
+    from crankmodal.results import savefig_atomic
+
+    with open(csv_path, newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["status"] == "ok"]
+    key = "dynamics.flexible."
+    outs = {"RMS of flexible − rigid": key + "rigid.main_bearing.difference_rms_n",
+            "peak": key + "rigid.main_bearing.peak_n",
+            "order 3": key + "rigid.main_bearing.order_amplitude_n.3"}
+    n = np.array([int(r[key + "crank.n_modes"]) for r in rows])
+    rt = np.array([float(r["dynamics.solver.rtol"]) for r in rows])
+    wall = np.array([float(r["dynamics.integration_wall_time_s"]) for r in rows])
+    ref = int(np.argmax(n * 1e9 - rt))  # most modes, tightest tolerance
+    plt = pyplot()
+    fig, ax = plt.subplots(1, 1, figsize=(7.5, 4.5))
+    print("| crank modes | rtol | wall (s) | RHS evaluations | " + " | ".join(
+        f"{k} (N), error" for k in outs) + " |")
+    print("|" + "---|" * (4 + len(outs)))
+    for (label, col), colour in zip(outs.items(), ("tab:blue", "tab:red", "tab:green")):
+        v = np.array([float(r[col]) for r in rows])
+        err = np.abs(v / v[ref] - 1.0)
+        for tol, mk, ls in ((1e-5, "o", "-"), (1e-7, "s", "--")):
+            m = (rt == tol) & (np.arange(len(v)) != ref)
+            ax.loglog(wall[m], np.maximum(err[m], 1e-6), marker=mk, ls=ls, color=colour,
+                      label=f"{label}, rtol {tol:g}")
+    for i in np.argsort(n * 10 + np.log10(rt)):
+        cells = []
+        for col in outs.values():
+            v = float(rows[i][col])
+            e = abs(v / float(rows[ref][col]) - 1.0)
+            cells.append(f"{v:.1f}, {100 * e:.2f} %")
+        print(f"| {n[i]} | {rt[i]:g} | {wall[i]:.1f} | {rows[i]['dynamics.rhs_evals']} | "
+              + " | ".join(cells) + " |")
+        if rt[i] == 1e-5:
+            ax.annotate(f"{n[i]}", (wall[i], 1.6e-6), fontsize=8, ha="center")
+    ax.set(xlabel="integration wall time [s]", ylabel="relative error against 12 modes, rtol 1e-7",
+           title="Flexible crank, main-bearing force: modal truncation (numbers: crank modes)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    savefig_atomic(fig, figure, dpi=110)
+    plt.close(fig)
+
+
 if __name__ == "__main__":
-    main(Path(sys.argv[1]), Path(sys.argv[2]))
+    if sys.argv[1] == "truncation":  # plot_seed000_flexible.py truncation OUT/sweep.csv PNG
+        truncation(Path(sys.argv[2]), Path(sys.argv[3]))
+    else:
+        main(Path(sys.argv[1]), Path(sys.argv[2]))
