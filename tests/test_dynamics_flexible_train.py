@@ -252,3 +252,19 @@ def test_bad_flexible_input_exits_2_with_one_line_naming_the_key(parts, tmp_path
     assert len(lines) == 1 and re.search(match, lines[0]), err  # only stage progress besides
     assert "Traceback" not in err
     assert not (out / "results.json").exists()
+
+
+def test_redundant_journals_are_refused_before_the_run(parts):
+    """A crank held at two journals without its tilts and with no elastic mode: four joint
+    equations on two coordinates' worth of freedom; refused by name, not a singular solve."""
+    from crankmodal.dynamics.flexible import load_flexible_body
+    from crankmodal.dynamics.mechanisms import RedundantJoints
+
+    crank, roles = flexbuild.crank_body(parts.crank, dict(SPEC_CRANK, n_modes=0), parts.rows,
+                                        parts.radius)
+    stiff = load_flexible_body(parts.crank, "crank", n_modes=0, orientation=crank.orientation)
+    stiff.frames.update({k: v for k, v in crank.frames.items() if k not in stiff.frames})
+    for name, (s0, _, _) in crank.frames.items():  # the same frames, without the tilt columns
+        stiff.frames[name] = (s0, np.zeros((2, 0)), np.zeros(0))
+    with pytest.raises(RedundantJoints, match="2 of its .* joint equations are redundant"):
+        _train(parts, stiff, roles)

@@ -66,6 +66,22 @@ class Mechanism:
             self.main_joints = [self.main_joint]
 
 
+class RedundantJoints(ValueError):
+    """The joints hold more than the bodies' coordinates can give (a singular system)."""
+
+
+def _check_rank(sysm, q, what: str) -> None:
+    """Refuse redundant constraints at the assembled state (the KKT matrix would be singular)."""
+    if not sysm.m:
+        return
+    _, Cq, _, _ = sysm.constraint_terms(0.0, q, np.zeros_like(q))
+    sv = np.linalg.svd(Cq, compute_uv=False)
+    rank = int(np.sum(sv > 1e-9 * sv[0]))
+    if rank < sysm.m:
+        raise RedundantJoints(f"{what}: {sysm.m - rank} of its {sysm.m} joint equations are "
+                              f"redundant (rank {rank})")
+
+
 def _offset(body, frame) -> np.ndarray:
     """Undeformed position of a body's frame relative to its reference point, m."""
     if isinstance(body, RigidBody):
@@ -111,6 +127,7 @@ def _finish(kind, bodies, pins, others, loads, clearance_specs, contact_kw, q0, 
         others = [c for c in others if not isinstance(c, AngleDrive)]
         extra = [drive]
     ideal = Multibody(bodies, pins + others, [], loads + extra, gravity, baumgarte)
+    _check_rank(ideal, q, f"{kind} with {len(bodies)} bodies")
     system = Multibody(bodies, ideal_pins + others, clear, loads + extra, gravity, baumgarte)
     return Mechanism(kind=kind, system=system, ideal=ideal, q0=q, qd0=qd, crank=crank, **meta)
 
@@ -229,7 +246,7 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         pins += [Revolute(f"big_end_{i}", crank, pin_frames[i - 1], rod, "big"),
                  Revolute(f"small_end_{i}", piston, "pin", rod, "small")]
         others.append(Prismatic(f"slider_{i}", piston, "pin", cyl.offset * nrm, u, cyl.axis_angle))
-        loads.append(PistonLoads(piston, "pin", u, cyl.axis_angle, crank, "main",
+        loads.append(PistonLoads(piston, "pin", u, cyl.axis_angle, crank, mains[0],
                                  cyl.gas_force, cyl.ring_friction, sense=direction))
         pistons.append(piston)
         axes.append(u)

@@ -40,6 +40,25 @@ def validate(raw: dict, scene) -> dict:
     return p
 
 
+def _build(build, p, mechanism_params, bodies, twin=False):
+    """``build(p, mechanism_params, bodies)``, redundant joints relabelled with the scene key."""
+    from ..errors import SceneError
+    from .mechanisms import RedundantJoints
+
+    try:
+        return build(p, mechanism_params, bodies)
+    except RedundantJoints as exc:
+        if bodies and bodies.get("crank") is not None:
+            n = len(bodies["crank"][1]["mains"])
+            if twin:
+                raise SceneError(f"dynamics.run_rigid: the rigid twin of a crank on {n} main "
+                                 f"journals is statically indeterminate ({exc}); set "
+                                 "run_rigid = false") from None
+            raise SceneError(f"dynamics.flexible.crank.n_modes: too few elastic modes for a "
+                             f"crank on {n} main journals ({exc}); keep more modes") from None
+        raise SceneError(f"dynamics: {exc}") from None
+
+
 def _start_warning(mech, p, rev_hz) -> str | None:
     """A flexible run started at full speed: the undeformed bodies ring through their modes."""
     slow = None
@@ -127,7 +146,7 @@ def run(params: dict, ctx) -> dict:
         from .flexstage import make_bodies
 
         bodies = make_bodies(p, ctx.params.get("mechanism"))
-    mech = build_mechanism(p, ctx.params.get("mechanism"), bodies)
+    mech = _build(build_mechanism, p, ctx.params.get("mechanism"), bodies)
     rev_hz = mech.revolution_hz
     settings = solver_settings(p, 60.0 * rev_hz)
     dt = p["output_step"] or 1.0 / (360.0 * rev_hz)
@@ -152,7 +171,8 @@ def run(params: dict, ctx) -> dict:
     if bodies is not None and p["run_rigid"]:
         from .flexstage import rigid_twins
 
-        rigid_mech = build_mechanism(p, ctx.params.get("mechanism"), rigid_twins(bodies))
+        rigid_mech = _build(build_mechanism, p, ctx.params.get("mechanism"), rigid_twins(bodies),
+                            twin=True)
         rigid = simulate(rigid_mech, t_end, dt, settings, energy_tolerance=tol)
     sel, n_rev = _window(hist, p, rev_hz)
     orders = list(range(13))
