@@ -156,6 +156,9 @@ FLEXIBLE = {
                    "flexible with the defaults)"),
     "rods": Field("table", {}, "every rod as a flexible body (absent: rigid; rods = {} flexible "
                   "with the defaults)"),
+    "start": Field("str", "quasi_static", "initial elastic state: quasi_static (the bodies "
+                   "deformed at rest under the loads at t = 0) or undeformed",
+                   choices=("quasi_static", "undeformed")),
 }
 
 FLEX_BODY = {

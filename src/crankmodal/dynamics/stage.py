@@ -76,7 +76,8 @@ def _start_warning(mech, p, rev_hz) -> str | None:
     return (f"dynamics.ramp_time: the flexible bodies start undeformed at full speed; the "
             f"start-up rings through their modes and decays to e^-5 only after {slow:.3g} s "
             f"(modal damping), after the results window opens at {t0:.3g} s; give a ramp "
-            f"(e.g. ramp_time = 0.1) or a later spectrum_start")
+            f"(e.g. ramp_time = 0.1), a later spectrum_start or flexible.start = "
+            f"'quasi_static'")
 
 
 def _probe_flexbody(key: str, spec: dict) -> None:
@@ -158,7 +159,12 @@ def run(params: dict, ctx) -> dict:
     early_warnings = []
     for text in timescales.check_budget(scales, t_end, settings.method, settings.max_rhs_evals):
         warn(text, into=early_warnings)
-    if bodies is not None and p["ramp_time"] == 0.0:
+    start_info = None
+    if bodies is not None and p["flexible"]["start"] == "quasi_static":
+        from .initial import quasi_static_start
+
+        mech.q0, mech.qd0, start_info = quasi_static_start(mech.system, mech.q0, mech.qd0)
+    elif bodies is not None and p["ramp_time"] == 0.0:
         text = _start_warning(mech, p, rev_hz)
         if text:
             warn(text, into=early_warnings)
@@ -236,6 +242,7 @@ def run(params: dict, ctx) -> dict:
 
         res["flexible"] = flexible_results(mech, hist, rigid, sel, rev_hz, bodies)
         res["flexible"]["rigid_integration_wall_time_s"] = None if rigid is None else rigid.wall_time
+        res["flexible"]["start"] = {"state": p["flexible"]["start"], **(start_info or {})}
     study = None
     if p["solver"]["study_rtols"]:
         rt = sorted(set(p["solver"]["study_rtols"]) | {settings.rtol / 10})
