@@ -115,3 +115,25 @@ def test_von_mises_render_of_a_linear_field_shows_the_whole_jet_ramp(tmp_path):
     reds = np.sum((img[..., 0] > 180) & (img[..., 1] < 80) & (img[..., 2] < 80))
     blues = np.sum((img[..., 2] > 150) & (img[..., 0] < 60) & (img[..., 1] < 80))
     assert reds > 100 and blues > 100
+
+
+def test_every_render_carries_the_xyz_axis_triad_in_its_lower_left_corner(tmp_path, bar_modes):
+    """Issue 20: a class such as "bending about y" must be matchable to the picture. The triad's
+    three axes (x tomato red, y sea green, z blue) are drawn in the lower-left viewport of the
+    mode PNGs and of the stress render, where the part (centred by the camera) never is."""
+    from crankmodal.report.render import render_modes, render_scalar
+
+    part, modes = bar_modes
+    out = render_modes(part.mesh.points, part.mesh.cells[0].data, modes.frequencies_hz[:1],
+                       modes.shapes[:, :1], tmp_path, labels=["bending about y"],
+                       window_size=(400, 300))
+    vm = render_scalar(out["surface"], part.mesh.points[:, 0], tmp_path / "vm.png", "x",
+                       out["camera"], window_size=(400, 300))
+    for path in (out["modes"][0], vm):
+        img = _image(path).astype(int)
+        h, w, _ = img.shape
+        box = img[int(0.7 * h):int(0.96 * h), :int(0.17 * w)]
+        r, g, b = box[..., 0], box[..., 1], box[..., 2]
+        assert np.sum((g > r + 40) & (g > b + 20)) > 10, path  # y axis
+        assert np.sum((r > g + 80) & (r > b + 80)) > 10, path  # x axis
+        assert np.sum((b > r + 80) & (b > g + 80)) > 10, path  # z axis

@@ -93,6 +93,10 @@ def test_results_carry_the_measured_comparison_and_a_summary(bar_report):
     assert cmp[0]["rel_error"] == pytest.approx(f[0] / 1200.0 - 1.0, rel=1e-12)
     assert "report.html" in rep["summary"] and "renders" in rep["summary"]
     assert (out / "von_mises.png").is_file() and len(rep["renders"]) == 2
+    # file names relative to the output folder (issue 20)
+    assert rep["renders"] == ["mode_01.png", "mode_02.png"] and rep["html"] == "report.html"
+    assert rep["von_mises_render"] == "von_mises.png" and rep["contact_sheet"] == "mode_sheet.png"
+    assert rep["sections"] == ["geometry", "material", "modal", "static"]
 
 
 def test_cantilever_first_mode_carries_61_percent_of_the_mass_in_participation_csv(bar_report):

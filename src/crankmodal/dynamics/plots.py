@@ -21,20 +21,46 @@ def _save(plt, fig, path: Path) -> Path:
     return path
 
 
-def plot_piston(hist, ideal, path: Path, piston: int = 0) -> Path:
-    """Piston acceleration against time and the acceleration-velocity phase diagram."""
+def last_revolutions(hist, n: float) -> np.ndarray:
+    """Boolean mask of the output times within the last ``n`` crank revolutions (by the crank
+    angle turned, either sense; the whole run when it is shorter)."""
+    a = np.asarray(hist.crank_angle, float)
+    if a.size == 0:
+        return np.zeros(0, bool)
+    return np.abs(a[-1] - a) <= 2.0 * np.pi * n
+
+
+def plot_piston(hist, ideal, path: Path, piston: int = 0, revolutions: float = 2.0) -> Path:
+    """Piston acceleration: the whole run against time (left), and the last ``revolutions``
+    against crank angle (middle) and as an acceleration-velocity phase diagram (right). The ideal
+    (clearance-free) run is drawn black and dashed on top of the run with clearance, so both
+    stay visible where the clearance trace spikes around it."""
     plt = _plt()
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.3))
+    sel = last_revolutions(hist, revolutions)
+    # crank angle turned since the window's start (either sense), the same origin for both runs
+    a0 = hist.crank_angle[sel][0] if sel.any() else 0.0
+    sense = 1.0 if hist.crank_angle[-1] >= hist.crank_angle[0] else -1.0
+    deg = np.degrees(sense * (hist.crank_angle[sel] - a0))
+    kw = {"color": "tab:orange", "lw": 0.6, "alpha": 0.85, "zorder": 1}
+    ax[0].plot(hist.t, hist.piston_acceleration[:, piston], label="with clearance", **kw)
+    ax[1].plot(deg, hist.piston_acceleration[sel, piston], **kw)
+    ax[2].plot(hist.piston_velocity[sel, piston], hist.piston_acceleration[sel, piston], **kw)
     if ideal is not None:
-        ax[0].plot(ideal.t, ideal.piston_acceleration[:, piston], "k--", lw=0.8, label="ideal")
-        ax[1].plot(ideal.piston_velocity[:, piston], ideal.piston_acceleration[:, piston], "k--",
-                   lw=0.8, label="ideal")
-    ax[0].plot(hist.t, hist.piston_acceleration[:, piston], lw=0.7, label="with clearance")
-    ax[1].plot(hist.piston_velocity[:, piston], hist.piston_acceleration[:, piston], lw=0.5)
-    ax[0].set(xlabel="t [s]", ylabel="piston acceleration [m/s²]", title=f"piston {piston + 1}")
-    ax[1].set(xlabel="piston velocity [m/s]", ylabel="piston acceleration [m/s²]",
-              title="phase diagram")
-    ax[0].legend()
+        isel = last_revolutions(ideal, revolutions)
+        ideg = np.degrees(sense * (ideal.crank_angle[isel] - a0))
+        kw = {"color": "black", "ls": "--", "lw": 1.4, "zorder": 3}
+        ax[0].plot(ideal.t, ideal.piston_acceleration[:, piston], label="ideal joints", **kw)
+        ax[1].plot(ideg, ideal.piston_acceleration[isel, piston], **kw)
+        ax[2].plot(ideal.piston_velocity[isel, piston], ideal.piston_acceleration[isel, piston],
+                   **kw)
+    ax[0].set(xlabel="t [s]", ylabel="piston acceleration [m/s²]",
+              title=f"piston {piston + 1}, whole run")
+    ax[1].set(xlabel="crank angle turned in the window [°]", ylabel="piston acceleration [m/s²]",
+              title=f"last {revolutions:g} revolutions")
+    ax[2].set(xlabel="piston velocity [m/s]", ylabel="piston acceleration [m/s²]",
+              title=f"phase diagram, last {revolutions:g} revolutions")
+    ax[0].legend(loc="upper right")
     return _save(plt, fig, path)
 
 
@@ -65,18 +91,39 @@ def _rev(spectrum):
     return spectrum.frequency_hz[k[0]] / spectrum.order[k[0]] if k.size else 1.0
 
 
-def plot_orbit(hist, clearances, path: Path) -> Path:
-    """Journal-centre orbit relative to the bore (bearing body's frame), in units of c."""
+def draw_orbit(ax, hist, name: str, clearance: float, sel: np.ndarray):
+    """Draw one joint's orbit (in units of the clearance c) on ``ax`` over the samples ``sel``,
+    a line coloured by time, and the clearance circle |e| = c bold on top; limits 1.15 c or the
+    orbit's reach. Returns the orbit's ``LineCollection`` (its array: the segments' times, s)."""
+    from matplotlib.collections import LineCollection
+
+    d = hist.contact[name]
+    xy = np.column_stack([d["ex_bearing"][sel], d["ey_bearing"][sel]]) / clearance
+    t = np.asarray(hist.t)[sel]
+    th = np.linspace(0, 2 * np.pi, 361)
+    ax.plot(np.cos(th), np.sin(th), "k-", lw=2.5, zorder=3)
+    lc = LineCollection(np.stack([xy[:-1], xy[1:]], axis=1), cmap="viridis", lw=0.9, zorder=2)
+    lc.set_array(0.5 * (t[:-1] + t[1:]))
+    ax.add_collection(lc)
+    lim = max(1.15, 1.05 * float(np.abs(xy).max(initial=0.0)))
+    ax.set(aspect="equal", xlim=(-lim, lim), ylim=(-lim, lim),
+           xlabel="e_x / c (bearing frame)", ylabel="e_y / c")
+    return lc
+
+
+def plot_orbit(hist, clearances, path: Path, revolutions: float = 2.0) -> Path:
+    """Journal-centre orbit relative to the bore (bearing body's frame), in units of the radial
+    clearance c, over the last ``revolutions`` crank revolutions, coloured by time; the
+    clearance circle (|e| = c, where contact starts) bold."""
     plt = _plt()
     n = max(len(clearances), 1)
-    fig, axs = plt.subplots(1, n, figsize=(4.5 * n, 4.5), squeeze=False)
+    fig, axs = plt.subplots(1, n, figsize=(5.2 * n, 4.6), squeeze=False)
+    sel = last_revolutions(hist, revolutions)
     for ax, (name, c) in zip(axs[0], clearances.items()):
-        d = hist.contact[name]
-        th = np.linspace(0, 2 * np.pi, 200)
-        ax.plot(np.cos(th), np.sin(th), "k-", lw=0.8)
-        ax.plot(d["ex_bearing"] / c, d["ey_bearing"] / c, lw=0.6)
-        ax.set(aspect="equal", xlabel="e_x / c (bearing frame)", ylabel="e_y / c",
-               title=f"journal orbit, {name}")
+        lc = draw_orbit(ax, hist, name, c, sel)
+        ax.set_title(f"journal orbit, {name}, last {revolutions:g} revolutions\n"
+                     f"(bold circle |e| = c: contact beyond it)")
+        fig.colorbar(lc, ax=ax, label="t [s]", shrink=0.85)
     return _save(plt, fig, path)
 
 

@@ -88,6 +88,7 @@ def run(p: dict, ctx) -> dict:
     if p["vtu"]:
         res["vtu"] = str(write_modes(ctx.out_dir / "modes.vtu", part.mesh,
                                      modes.frequencies_hz, modes.shapes))
+        res["files"] = ["modes.vtu"]  # relative to the output folder (vtu: the full path)
     f = modes.frequencies_hz
     kind = "free-free" if not sup else f"{len(sup)} supports"
     res["summary"] = (f"{len(f)} elastic modes ({kind}, {modes.rigid_body_modes} rigid), "

@@ -130,6 +130,7 @@ def run(p: dict, ctx) -> dict:
         data = {"displacement": res.displacement, "von_mises": res.von_mises,
                 "principal": res.principal}
         out["vtu"] = str(write_point_data(ctx.out_dir / "static.vtu", part.mesh, data))
+        out["files"] = ["static.vtu"]  # relative to the output folder (vtu: the full path)
     sfu = res.safety_factor_ultimate
     out["summary"] = (f"max von Mises {res.max_von_mises / 1e6:.4g} MPa at "
                       f"{np.array2string(res.max_location, precision=4)} m, max displacement "

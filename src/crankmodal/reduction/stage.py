@@ -3,12 +3,15 @@
 Keys are declared in :data:`SCHEMA` (interface tables in :data:`INTERFACE_SCHEMA`). Results:
 sizes, interfaces, fixed-interface and reduced free-free frequencies, the full model's
 free-free frequencies and the relative differences, mass properties, timings per phase, peak
-memory; the body is written to ``out_dir/<file>`` (format: :mod:`crankmodal.reduction.io`) and
-handed on as ``ctx.products["reduction"]``.
+memory; the body (with its mesh and mode shapes) is written to ``out_dir/<file>`` (format:
+:mod:`crankmodal.reduction.io`), its elastic modes to ``out_dir/<file stem>_modes.vtu`` (one point
+vector per mode, :func:`crankmodal.reduction.export.write_modes_vtu`), and the body is handed on
+as ``ctx.products["reduction"]``.
 """
 
 from __future__ import annotations
 
+import os
 import time
 
 from ..errors import SceneError
@@ -101,6 +104,7 @@ def run(p: dict, ctx) -> dict:
 
     from ..fem.memory import PeakMemory
     from ..fem.stage_common import part_and_material, timed_fe_model
+    from .export import write_modes_vtu
     from .interfaces import make_interfaces
     from .io import save_flexbody
     from .reduce import reduce_body
@@ -110,9 +114,8 @@ def run(p: dict, ctx) -> dict:
         model, t_asm = timed_fe_model(ctx, part, mat)
         itf = make_interfaces(part, interface_specs(part, p))
         body, cb = reduce_body(model, itf, n_modes=p["n_modes"], cutoff_hz=p["cutoff_hz"],
-                               backend=p["backend"],
-                               mesh=part.mesh if p["stress_modes"] else None, name=part.name,
-                               info={"part": part.name, "material": mat.name})
+                               backend=p["backend"], mesh=part.mesh, stress=p["stress_modes"],
+                               name=part.name, info={"part": part.name, "material": mat.name})
         timings = {"assembly_s": t_asm, **body.info["timings_s"]}
         full = None
         if p["compare_full"]:
@@ -123,6 +126,7 @@ def run(p: dict, ctx) -> dict:
             timings["full_modal_s"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     path = save_flexbody(ctx.out_dir / p["file"], body)
+    vtu = write_modes_vtu(path.with_name(f"{path.stem}_modes.vtu"), body)
     timings["write_s"] = time.perf_counter() - t0
     ctx.products[SECTION] = body
     fr = body.elastic_frequencies_hz
@@ -150,6 +154,9 @@ def run(p: dict, ctx) -> dict:
         "timings_s": timings,
         "peak_memory_bytes": mem.peak,
         "file": str(path),
+        "modes_vtu": str(vtu),
+        # relative to the output folder (file, modes_vtu: the full paths)
+        "files": [os.path.relpath(path, ctx.out_dir), os.path.relpath(vtu, ctx.out_dir)],
     }
     cmp = ""
     if full is not None:

@@ -22,6 +22,7 @@ _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;
 margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
 h1{border-bottom:2px solid #335;padding-bottom:.2em}h2{margin-top:1.8em;color:#335}
+h3{margin-top:1.2em;color:#446}
 table{border-collapse:collapse;margin:.6em 0;font-size:.9em}
 th,td{border:1px solid #bbb;padding:.25em .6em;text-align:right}
 th{background:#eef}td:first-child,th:first-child{text-align:left}
@@ -37,8 +38,9 @@ class Report:
     title: str
     blocks: list = field(default_factory=list)
 
-    def heading(self, text: str):
-        self.blocks.append(("h2", text))
+    def heading(self, text: str, level: int = 2):
+        """A section (``level`` 2) or subsection (3) heading."""
+        self.blocks.append((f"h{min(max(int(level), 2), 3)}", text))
 
     def paragraph(self, text: str):
         self.blocks.append(("p", text))
@@ -55,8 +57,8 @@ class Report:
                f"<title>{html.escape(self.title)}</title><style>{_CSS}</style></head><body>",
                f"<h1>{html.escape(self.title)}</h1>"]
         for b in self.blocks:
-            if b[0] == "h2":
-                out.append(f"<h2>{html.escape(b[1])}</h2>")
+            if b[0] in ("h2", "h3"):
+                out.append(f"<{b[0]}>{html.escape(b[1])}</{b[0]}>")
             elif b[0] == "p":
                 out.append(f"<p>{html.escape(b[1])}</p>")
             elif b[0] == "table":
@@ -79,8 +81,8 @@ class Report:
         """Markdown with images linked by file name (relative to ``relative_to``)."""
         out = [f"# {self.title}", ""]
         for b in self.blocks:
-            if b[0] == "h2":
-                out += [f"## {b[1]}", ""]
+            if b[0] in ("h2", "h3"):
+                out += ["#" * int(b[0][1]) + f" {b[1]}", ""]
             elif b[0] == "p":
                 out += [b[1], ""]
             elif b[0] == "table":
@@ -159,7 +161,8 @@ def measured_rows(frequencies_hz, measured_hz) -> list[list]:
 
 def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
                  renders: dict | None = None, mac: dict | None = None,
-                 measured_hz=None, timings: dict | None = None, extra_images=()) -> Report:
+                 measured_hz=None, timings: dict | None = None, extra_images=(),
+                 level: int = 2, versions_table: bool = True) -> Report:
     """Fill a report with the standard modal content.
 
     Parameters
@@ -174,9 +177,16 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
     timings : dict, optional
         Section -> wall time, s.
     extra_images : iterable of (path, caption)
+    level : int
+        Heading level of its sections (2, or 3 inside a scene report's section).
+    versions_table : bool
+        End with the installed versions (a scene report puts them at its own end).
     """
+    def heading(text):
+        report.heading(text, level)
+
     q = geometry.get("quality") or {}
-    report.heading("Part and mesh")
+    heading("Part and mesh")
     rows = [["part", geometry.get("name")], ["fidelity", geometry.get("fidelity")],
             ["element order", f"P{geometry.get('element_order')}"],
             ["elements", geometry.get("n_elements")], ["nodes", geometry.get("n_nodes")],
@@ -188,7 +198,7 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
     if modal.get("mass_vs_cad") is not None:
         rows.append(["mesh mass vs CAD", f"{100 * modal['mass_vs_cad']:+.3f} %"])
     report.table(["quantity", "value"], rows)
-    report.heading("Material")
+    heading("Material")
     E = material.get("E_pa", material.get("E"))
     rho = material.get("rho_kg_m3", material.get("rho"))
     mrows = [["name", material.get("name")], ["E, GPa", None if E is None else f"{E / 1e9:.4g}"],
@@ -200,7 +210,7 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
     if material.get("description"):
         mrows.append(["description", material["description"]])
     report.table(["quantity", "value"], mrows)
-    report.heading("Supports")
+    heading("Supports")
     sup = modal.get("supports") or []
     if sup:
         report.table(["support", "fixed", "nodes"], [[s["label"], s["fix"], s["n_nodes"]]
@@ -208,23 +218,23 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
     else:
         report.paragraph(f"Free-free: {modal.get('rigid_body_modes')} rigid-body modes found "
                          f"and left out.")
-    report.heading("Natural frequencies and mode shapes")
+    heading("Natural frequencies and mode shapes")
     report.table(MODE_HEADER, mode_rows(modal))
     report.paragraph(f"Largest eigen-residual ‖Kφ − λMφ‖/‖Kφ‖: {modal.get('residual_max', 0):.1e}; "
                      f"M-orthogonality defect {modal.get('m_orthogonality_max', 0):.1e}. Effective "
                      f"masses: translations in kg, rotations about the centre of mass in kg m².")
     if measured_hz:
-        report.heading("Comparison with measured frequencies")
+        heading("Comparison with measured frequencies")
         report.table(["mode", "measured, Hz", "computed, Hz", "difference"],
                      measured_rows(modal["frequencies_hz"], measured_hz))
     if mac:
-        report.heading("MAC against the reference modes")
+        heading("MAC against the reference modes")
         report.paragraph(f"Reference: {mac['source']}. Pairs (mode ↔ reference, MAC): "
                          + ", ".join(f"{i + 1} ↔ {j + 1} ({v:.2f})" for i, j, v in mac["pairs"]))
         if mac.get("image"):
             report.image(mac["image"], "MAC matrix")
     if renders:
-        report.heading("Mode-shape renders")
+        heading("Mode-shape renders")
         if renders.get("sheet"):
             report.image(renders["sheet"], "All modes (same camera)")
         for p in renders.get("modes", []):
@@ -234,10 +244,11 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
     for path, caption in extra_images:
         report.image(path, caption)
     if timings:
-        report.heading("Timings")
+        heading("Timings")
         report.table(["step", "wall time, s"], [[k, f"{v:.3g}"] for k, v in timings.items()])
-    report.heading("Versions")
-    report.table(["package", "version"], [[k, v] for k, v in versions().items()])
+    if versions_table:
+        heading("Versions")
+        report.table(["package", "version"], [[k, v] for k, v in versions().items()])
     return report
 
 

@@ -131,6 +131,12 @@ def _plotter(window_size):
     return pl
 
 
+def _add_triad(pl):
+    """The x/y/z axis triad in the lower-left corner (above the scale note), so a class such as
+    "bending about y" can be matched to the picture."""
+    pl.add_axes(color="black", line_width=3, labels_off=False, viewport=(0.0, 0.04, 0.17, 0.3))
+
+
 def _place_camera(pl, camera):
     pl.camera_position = [camera["position"], camera["focal_point"], camera["view_up"]]
     pl.camera.view_angle = 30.0
@@ -183,6 +189,7 @@ def render_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: d
         pl.add_text(title, position="upper_edge", font_size=14, color="black")
         pl.add_text(f"deformation scaled to {100 * fraction:.0f} % of the part's size",
                     position="lower_left", font_size=9, color="#555555")
+        _add_triad(pl)
         _place_camera(pl, camera)
         with atomic_path(path) as tmp:
             pl.screenshot(str(tmp))
@@ -203,6 +210,7 @@ def animate_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: 
     try:
         mesh, scale = _add_mode_actors(pl, surface, u, camera, fraction, ghost=True)
         pl.add_text(title, position="upper_edge", font_size=12, color="black")
+        _add_triad(pl)
         _place_camera(pl, camera)
         for k in range(n_frames):
             s = np.sin(2 * np.pi * k / n_frames)
@@ -246,6 +254,7 @@ def render_scalar(surface: Surface, values: np.ndarray, path, title: str, camera
                                      "position_x": 0.87, "position_y": 0.15, "height": 0.7,
                                      "width": 0.06, "fmt": "%.3g"})
         pl.add_text(title, position="upper_edge", font_size=14, color="black")
+        _add_triad(pl)
         _place_camera(pl, camera)
         with atomic_path(path) as tmp:
             pl.screenshot(str(tmp))

@@ -1,11 +1,13 @@
-"""The ``[report]`` scene section: modal report (HTML + Markdown), renders, plots, studies.
+"""The ``[report]`` scene section: the report of the whole scene (HTML + Markdown), renders,
+plots, studies.
 
-Needs ``[geometry]``, ``[material]`` and ``[modal]`` (it reads the Part, the Material and the
-:class:`~crankmodal.fem.modal.Modes` from ``ctx.products``); a ``[static]`` section adds a von
-Mises render. Writes ``report.html`` (self-contained), ``report.md``, ``mode_NN.png``,
-``mode_sheet.png`` (+ ``mode_NN.gif`` when ``gif``), ``participation.png/.csv`` (supported
-parts),
-``mac.png/.csv`` (with ``reference``), ``von_mises.png``; with ``study = true`` also the
+One section per stage the scene ran, each with its verdict (the stage's ``summary`` and
+``warnings``), its key tables and every figure it lists (:mod:`crankmodal.report.scene_report`).
+With ``[geometry]``, ``[material]`` and ``[modal]`` it adds the modal content (it reads the Part,
+the Material and the :class:`~crankmodal.fem.modal.Modes` from ``ctx.products``); a ``[static]``
+section adds a von Mises render. Writes ``report.html`` (self-contained), ``report.md``,
+``mode_NN.png``, ``mode_sheet.png`` (+ ``mode_NN.gif`` when ``gif``), ``participation.png/.csv``
+(supported parts), ``mac.png/.csv`` (with ``reference``), ``von_mises.png``; with ``study = true`` also the
 simplification study's files (see :mod:`crankmodal.report.study_scene`).
 """
 
@@ -18,7 +20,7 @@ from ..schema import Field
 from ..schema import validate as validate_table
 
 SECTION = "report"
-REQUIRES = ("geometry", "material", "modal")
+REQUIRES = ()
 
 SCHEMA: dict[str, Field] = {
     "title": Field("str", None, "report title (default: the part's name and fidelity)"),
@@ -54,8 +56,17 @@ SCHEMA: dict[str, Field] = {
 }
 
 
+#: keys that need the FE part's modes ([geometry], [material] and [modal] in the scene)
+MODAL_KEYS = ("measured_hz", "measured_modes", "reference", "study")
+
+
 def validate(raw: dict, scene) -> dict:
     p = validate_table(SECTION, raw, SCHEMA)
+    missing = [s for s in ("geometry", "material", "modal") if s not in scene.sections]
+    for key in MODAL_KEYS:
+        if missing and p[key]:
+            raise SceneError(f"report.{key}: needs the part's modes; the scene has no "
+                             + ", ".join(f"[{s}]" for s in missing))
     if p["reference"] is not None:
         from ..errors import InputFileError
 
@@ -114,21 +125,89 @@ def _mac(part, modes, p, out_dir, figures):
 
 
 def run(p: dict, ctx) -> dict:
-    from ..fem.modal import Modes
+    """Write ``report.html``/``report.md``: one section per stage the scene ran (its verdict,
+    tables and every figure it lists), the modal content when the scene has [modal]."""
     from ..results import to_jsonable
-    from .modal_report import Report, modal_blocks, write_report
+    from .modal_report import Report, versions, write_report
+    from .scene_report import (
+        MODAL_SECTIONS,
+        overview_rows,
+        relative_name,
+        scene_title,
+        stage_section,
+    )
+
+    out_dir = ctx.out_dir
+    results = {s: to_jsonable(r) for s, r in ctx.results.items() if isinstance(r, dict)}
+    fe_only = set(results) <= {*MODAL_SECTIONS, "static", "report"}
+    modes = ctx.products.get("modal")
+    part = ctx.products.get("geometry")
+    out: dict = {}
+    title = p["title"]
+    if title is None:
+        title = (f"Modal report: {part.name} ({part.fidelity}, P{part.element_order})"
+                 if fe_only and part is not None
+                 else scene_title(ctx.scene, ctx.params, results))
+    rep = Report(title)
+    scene = ctx.scene
+    rep.paragraph(f"Scene {scene.name!r}" + (f" ({scene.path})" if scene.path else "")
+                  + (f": {' '.join(scene.description.split())}" if scene.description else "."))
+    rep.table(["section", "wall time, s", "verdict"], overview_rows(results))
+    modal = _modal_section(p, ctx, rep, results, out) if "modal" in ctx.params else None
+    for section, res in results.items():
+        if section in MODAL_SECTIONS or section == SECTION:
+            continue
+        images = []
+        if section == "static" and modal and modal.get("von_mises"):
+            images.append((modal["von_mises"], "von Mises stress on the deformed shape"))
+        stage_section(rep, section, res, out_dir, images=images)
+    if p["study"]:
+        _study(p, ctx, rep, out, modal["measured"] if modal else None)
+    timings = {f"[{s}]": r["wall_time_s"] for s, r in results.items() if "wall_time_s" in r}
+    for k, v in (results.get("modal", {}).get("timings_s") or {}).items():
+        timings[f"modal: {k}"] = v
+    rep.heading("Timings")
+    rep.table(["step", "wall time, s"], [[k, f"{v:.3g}"] for k, v in timings.items()])
+    rep.heading("Versions")
+    rep.table(["package", "version"], [[k, v] for k, v in versions().items()])
+    files = write_report(rep, out_dir)
+    out.update({k: relative_name(v, out_dir) for k, v in files.items()})
+    n_fig = sum(1 for b in rep.blocks if b[0] == "img")
+    sections = [s for s in results if s != SECTION]
+    out["sections"] = sections
+    out["figures_embedded"] = n_fig
+    head = f"report.html: {len(sections)} stages ({', '.join(sections)}), {n_fig} figures"
+    if modes is not None and "modal" in results:
+        f = modes.frequencies_hz
+        extra = ""
+        if modal and modal["measured"]:
+            worst = max((abs(r["rel_error"]) for r in out["measured_comparison"]
+                         if r["rel_error"] is not None), default=0.0)
+            extra = f", max {100 * worst:.1f} % off measured"
+        head += (f"; {len(f)} modes {f[0]:.0f}-{f[-1]:.0f} Hz, "
+                 f"{len(out.get('renders', []))} renders{extra}")
+    out["summary"] = head + (f"; study: {out['study']['recommendation']}" if p["study"] else "")
+    return out
+
+
+def _modal_section(p, ctx, rep, results, out) -> dict:
+    """The FE part's section: renders, participation, MAC, measured comparison, the modal
+    tables; fills ``out`` (names relative to the output folder). Returns ``measured`` and the
+    von Mises render (for the [static] section)."""
+    from ..fem.modal import Modes
+    from .modal_report import modal_blocks
+    from .scene_report import relative_name, verdict
 
     part = ctx.products.get("geometry")
     modes = ctx.products.get("modal")
     if not isinstance(modes, Modes):
         raise SceneError("[report] needs the Modes of [modal] in the run")
-    res = ctx.results
-    modal_res = res.get("modal", {})
-    geo_res = res.get("geometry") or part.summary()
+    modal_res = results.get("modal", {})
+    geo_res = results.get("geometry") or to_jsonable_summary(part)
     out_dir = ctx.out_dir
-    out: dict = {}
     renders = None
     images = []
+    von_mises = None
     n_r = min(p["max_renders"], len(modes.frequencies_hz))
     labels = modal_res.get("classes")
     if p["renders"] and ctx.figures:
@@ -138,19 +217,19 @@ def run(p: dict, ctx) -> dict:
         renders = render_modes(part.mesh.points, cells, modes.frequencies_hz[:n_r],
                                modes.shapes[:, :n_r], out_dir,
                                labels=labels[:n_r] if labels else None, gif=p["gif"])
-        out["renders"] = [str(x) for x in renders["modes"]]
-        out["gifs"] = [str(x) for x in renders["gifs"]]
+        out["renders"] = [relative_name(x, out_dir) for x in renders["modes"]]
+        out["gifs"] = [relative_name(x, out_dir) for x in renders["gifs"]]
         if renders["sheet"]:
-            out["contact_sheet"] = str(renders["sheet"])
+            out["contact_sheet"] = relative_name(renders["sheet"], out_dir)
         static = ctx.products.get("static")
         if static is not None and p["stress"]:
             from .render import render_scalar
 
-            vm = render_scalar(renders["surface"], static.von_mises, out_dir / "von_mises.png",
-                               f"von Mises stress, max {static.max_von_mises / 1e6:.4g} MPa",
-                               renders["camera"], displacement=static.displacement)
-            images.append((vm, "Static load case: von Mises stress on the deformed shape"))
-            out["von_mises_render"] = str(vm)
+            von_mises = render_scalar(renders["surface"], static.von_mises,
+                                      out_dir / "von_mises.png",
+                                      f"von Mises stress, max {static.max_von_mises / 1e6:.4g} MPa",
+                                      renders["camera"], displacement=static.displacement)
+            out["von_mises_render"] = relative_name(von_mises, out_dir)
     # free-free elastic modes carry no effective mass: the plot only says something when held
     held = float(np.sum(modes.effective_mass[:, :3])) > 1e-6 * modes.total_mass
     if ctx.figures and held:
@@ -171,54 +250,48 @@ def run(p: dict, ctx) -> dict:
                                                          rtol=1.0)
         for r in out["measured_comparison"]:
             del r["rtol"], r["ok"]
-    timings = {f"[{s}]": r["wall_time_s"] for s, r in res.items()
-               if isinstance(r, dict) and "wall_time_s" in r}
-    for k, v in (modal_res.get("timings_s") or {}).items():
-        timings[f"modal: {k}"] = v
-    title = p["title"] or f"Modal report: {part.name} ({part.fidelity}, P{part.element_order})"
-    rep = Report(title)
-    scene = ctx.scene
-    rep.paragraph(f"Scene {scene.name!r}" + (f" ({scene.path})" if scene.path else "")
-                  + (f": {' '.join(scene.description.split())}" if scene.description else "."))
-    rep.table(["section", "wall time, s", "summary"],
-              [[f"[{s}]", f"{r.get('wall_time_s', 0.0):.3g}", r.get("summary", "")]
-               for s, r in res.items() if isinstance(r, dict)])
-    rep = modal_blocks(rep, geometry=to_jsonable(geo_res),
-                       material=to_jsonable(res.get("material", {})),
-                       modal=to_jsonable(modal_res), renders=renders, mac=mac,
-                       measured_hz=measured,
-                       timings=timings, extra_images=images)
-    if p["study"]:
-        from .study_scene import run_simplification
+    rep.heading(f"Part, material and modes: {part.name} [geometry] [material] [modal]")
+    for s in MODAL_ORDER:
+        if s in results:
+            verdict(rep, results[s], label=s)
+    if von_mises is not None and "static" not in results:
+        images.append((von_mises, "Static load case: von Mises stress on the deformed shape"))
+    modal_blocks(rep, geometry=geo_res, material=results.get("material", {}), modal=modal_res,
+                 renders=renders, mac=mac, measured_hz=measured, extra_images=images, level=3,
+                 versions_table=False)
+    return {"measured": measured, "von_mises": von_mises}
 
-        st, paths = run_simplification(ctx.params, out_dir, figures=ctx.figures,
-                                       material=ctx.products.get("material"))
-        rep.heading("Mesh-simplification study")
-        rep.paragraph(f"Reference per mode: {', '.join(sorted(set(st.reference_source)))}; a "
-                      f"model's error is the largest |f − f_ref|/f_ref over the first "
-                      f"{st.compared_modes} modes, its cost the wall time to mesh and solve. "
-                      f"Modes are paired with the reference model's by MAC on common surface "
-                      f"points († marks a mode paired out of rank order).")
-        rep.table(*st.table(measured))
-        rep.paragraph(f"Recommendation (tolerance {100 * st.tolerance:.3g} %): "
-                      f"{st.recommendation_text()}.")
-        for key, cap in (("error_vs_time", "Error against run time, Pareto front dashed"),
-                         ("convergence", "Frequency against DOF")):
-            if key in paths:
-                rep.image(paths[key], cap)
-        for key in (k for k in paths if k.startswith("mac_")):
-            rep.image(paths[key], f"MAC of the finest {key[4:]} model against the reference "
-                                  f"model (common surface points)")
-        out["study"] = st.to_dict()
-    files = write_report(rep, out_dir)
-    out.update({k: str(v) for k, v in files.items()})
-    f = modes.frequencies_hz
-    extra = ""
-    if measured:
-        worst = max((abs(r["rel_error"]) for r in out["measured_comparison"]
-                     if r["rel_error"] is not None), default=0.0)
-        extra = f", max {100 * worst:.1f} % off measured"
-    out["summary"] = (f"report.html: {len(f)} modes {f[0]:.0f}-{f[-1]:.0f} Hz, "
-                      f"{len(out.get('renders', []))} renders{extra}"
-                      + (f"; study: {out['study']['recommendation']}" if p["study"] else ""))
-    return out
+
+MODAL_ORDER = ("geometry", "material", "modal")
+
+
+def to_jsonable_summary(part) -> dict:
+    """The part's summary as JSON types (when [geometry] left no results)."""
+    from ..results import to_jsonable
+
+    return to_jsonable(part.summary())
+
+
+def _study(p, ctx, rep, out, measured) -> None:
+    """The mesh-simplification study (``study = true``) as a section of the report."""
+    from .study_scene import run_simplification
+
+    st, paths = run_simplification(ctx.params, ctx.out_dir, figures=ctx.figures,
+                                   material=ctx.products.get("material"))
+    rep.heading("Mesh-simplification study")
+    rep.paragraph(f"Reference per mode: {', '.join(sorted(set(st.reference_source)))}; a "
+                  f"model's error is the largest |f − f_ref|/f_ref over the first "
+                  f"{st.compared_modes} modes, its cost the wall time to mesh and solve. "
+                  f"Modes are paired with the reference model's by MAC on common surface "
+                  f"points († marks a mode paired out of rank order).")
+    rep.table(*st.table(measured))
+    rep.paragraph(f"Recommendation (tolerance {100 * st.tolerance:.3g} %): "
+                  f"{st.recommendation_text()}.")
+    for key, cap in (("error_vs_time", "Error against run time, Pareto front dashed"),
+                     ("convergence", "Frequency against DOF")):
+        if key in paths:
+            rep.image(paths[key], cap)
+    for key in (k for k in paths if k.startswith("mac_")):
+        rep.image(paths[key], f"MAC of the finest {key[4:]} model against the reference "
+                              f"model (common surface points)")
+    out["study"] = st.to_dict()
