@@ -196,3 +196,32 @@ def test_orbit_png_is_written_in_colour(tmp_path):
     img = img.astype(int)
     coloured = (img.max(axis=2) - img.min(axis=2)) > 80
     assert coloured.sum() > 1000 and np.all(img < 60, axis=2).sum() > 1000
+
+
+def test_piston_plot_draws_the_ideal_run_dashed_on_top_and_the_last_revolutions(monkeypatch,
+                                                                               tmp_path):
+    """The ideal (clearance-free) curve was hidden under the clearance trace: it is drawn black,
+    dashed, above it in every panel; the middle and right panels hold the last 2 revolutions."""
+    from types import SimpleNamespace
+
+    from crankmodal.dynamics import plots
+
+    t = np.linspace(0.0, 0.25, 2501)
+    ang = -2 * np.pi * 20.0 * t  # five revolutions, turning in the negative sense
+    ideal = SimpleNamespace(t=t, crank_angle=ang, piston_velocity=np.sin(ang)[:, None],
+                            piston_acceleration=np.cos(ang)[:, None])
+    rough = SimpleNamespace(t=t, crank_angle=ang, piston_velocity=np.sin(ang)[:, None],
+                            piston_acceleration=(np.cos(ang) + 5 * np.sin(40 * ang))[:, None])
+    figs = []
+    monkeypatch.setattr(plots, "_save", lambda plt, fig, path: figs.append(fig) or path)
+    plots.plot_piston(rough, ideal, tmp_path / "p.png")
+    axes = figs[0].axes
+    assert len(axes) >= 2
+    for ax in axes:
+        lines = ax.get_lines()
+        ideal_line = [ln for ln in lines if ln.get_linestyle() == "--"]
+        other = [ln for ln in lines if ln.get_linestyle() != "--"]
+        assert len(ideal_line) == 1 and other
+        assert ideal_line[0].get_zorder() > max(ln.get_zorder() for ln in other)
+    last = axes[1].get_lines()[0].get_xdata()
+    assert len(last) == 1001 and min(last) == pytest.approx(0.0) and max(last) == pytest.approx(720)
