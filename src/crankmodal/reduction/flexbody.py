@@ -1,4 +1,4 @@
-"""The flexible body a dynamics solver needs, with no mesh in it.
+"""The flexible body a dynamics solver needs (and, optionally, its mesh and mode shapes).
 
 A :class:`FlexibleBody` holds, in orthonormal modal coordinates ``ξ`` (rigid modes first):
 
@@ -7,7 +7,10 @@ A :class:`FlexibleBody` holds, in orthonormal modal coordinates ``ξ`` (rigid mo
 - the interface map: ``q_r = Φ_r ξ`` gives the 6 DOFs (m, rad) of interface node ``r`` — constant
   matrices, so joint and bearing forces act on ``ξ`` through ``Φ_rᵀ``;
 - rigid-body mass properties;
-- Shabana's inertia invariants of the elastic modes for the floating frame of reference.
+- Shabana's inertia invariants of the elastic modes for the floating frame of reference;
+- optionally the mesh (points and tetra/tetra10 cells) and every mode shape on its nodes, for
+  looking at the modes (a VTU) and for exporting the body to another multibody code
+  (:mod:`crankmodal.reduction.export`).
 
 Invariants (Shabana, *Dynamics of Multibody Systems*; the nine of an Adams MNF), for a body of
 density ρ with undeformed positions ``x`` and elastic mode shapes ``φ_a`` (columns of ``Φ``), in
@@ -78,6 +81,16 @@ class FlexibleBody:
         Nodal stresses per unit modal coordinate, Pa (Voigt order xx, yy, zz, yz, xz, xy).
     stress_points : ndarray, shape (n_points, 3) or None
         Where those stresses sit, m.
+    mesh_points : ndarray, shape (n_points, 3) or None
+        The part's mesh points (undeformed, part frame), m.
+    mesh_cells : ndarray of int, shape (n_elements, 4 or 10) or None
+        Connectivity into ``mesh_points`` in meshio order.
+    mesh_cell_type : str or None
+        ``tetra`` or ``tetra10``.
+    mode_shapes : ndarray, shape (n_points, 3, n) or None
+        Nodal displacement (m) per unit modal coordinate ``ξ`` of every orthonormal mode (rigid
+        first): ``u = mode_shapes @ ξ``; M-orthonormal against the FE mass matrix, stored as
+        float32.
     info : dict
         Provenance (part, material, coupling, timings).
     """
@@ -105,6 +118,10 @@ class FlexibleBody:
     stress_modes: np.ndarray | None = None
     stress_points: np.ndarray | None = None
     info: dict = field(default_factory=dict)
+    mesh_points: np.ndarray | None = None
+    mesh_cells: np.ndarray | None = None
+    mesh_cell_type: str | None = None
+    mode_shapes: np.ndarray | None = None
 
     @property
     def n_modes(self) -> int:
@@ -113,6 +130,11 @@ class FlexibleBody:
     @property
     def elastic_frequencies_hz(self) -> np.ndarray:
         return self.frequencies_hz[~self.rigid]
+
+    @property
+    def has_mesh(self) -> bool:
+        """Whether the body carries its mesh and the mode shapes on it."""
+        return self.mode_shapes is not None and self.mesh_points is not None
 
     def to_dict(self) -> dict:
         """JSON-able summary (no mode-sized arrays beyond the frequency list)."""
@@ -130,6 +152,7 @@ class FlexibleBody:
             "centre_of_mass_m": self.centre_of_mass.tolist(),
             "inertia_kgm2": self.inertia.tolist(),
             "has_stress_modes": self.stress_modes is not None,
+            "has_mode_shapes": self.has_mesh,
         }
 
 
@@ -175,7 +198,8 @@ def inertia_invariants(points: np.ndarray, Ms, shapes: np.ndarray) -> dict:
 
 
 def flexible_body(model, cb, ortho, name: str = "body", stress_modes=None,
-                  info: dict | None = None) -> FlexibleBody:
+                  info: dict | None = None, mode_shapes: bool = False,
+                  shape_dtype=np.float32) -> FlexibleBody:
     """Assemble the :class:`FlexibleBody` of a Craig–Bampton basis and its orthonormalisation.
 
     Parameters
@@ -187,6 +211,11 @@ def flexible_body(model, cb, ortho, name: str = "body", stress_modes=None,
     stress_modes : ndarray, shape (n_points, 6, n), optional
         From :func:`crankmodal.reduction.stress_modes.stress_modes` of ``cb.V @ ortho.W``.
     info : dict, optional
+    mode_shapes : bool
+        Store the mesh (``model.points``, ``model.cells``) and every orthonormal mode shape
+        ``cb.V @ ortho.W`` on its nodes.
+    shape_dtype : numpy dtype
+        Storage type of the mode shapes.
     """
     W = ortho.W
     n = W.shape[1]
@@ -210,6 +239,11 @@ def flexible_body(model, cb, ortho, name: str = "body", stress_modes=None,
         inertia=mp.inertia, invariants=inv, n_full_dofs=int(model.n_dofs),
         stress_modes=stress_modes,
         stress_points=None if stress_modes is None else model.points,
+        mesh_points=np.asarray(model.points, float) if mode_shapes else None,
+        mesh_cells=np.asarray(model.cells) if mode_shapes else None,
+        mesh_cell_type=("tetra10" if model.order == 2 else "tetra") if mode_shapes else None,
+        mode_shapes=((cb.V @ W).reshape(len(model.points), 3, n).astype(shape_dtype)
+                     if mode_shapes else None),
         info={**(info or {}), "k_modal_offdiag": float(np.abs(K - np.diag(np.diag(K))).max()
                                                        / max(np.abs(np.diag(K)).max(), 1e-300)),
               "m_orthonormality": float(np.abs(Mm - np.eye(n)).max())})

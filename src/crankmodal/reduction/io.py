@@ -2,7 +2,8 @@
 
 Format ``crankmodal-flexbody``, version 1. Open with ``np.load(path)`` (no pickle needed). SI
 units; ``n`` orthonormal modes (the six rigid ones first), ``m`` interface nodes, ``p`` mesh
-points (only when stress modes were stored).
+points, ``e`` elements (the optional keys are present only when the reduction had the mesh, as
+the ``[reduction]`` stage always has; files without them stay valid version-1 files).
 
 =========================  ==================  ===============================================
 key                        shape / dtype       meaning
@@ -30,6 +31,12 @@ I1 … I9                    see flexbody.py     Shabana inertia invariants of t
 n_full_dofs                int
 stress_modes               (p, 6, n) optional  Pa per unit ξ, Voigt xx yy zz yz xz xy
 stress_points              (p, 3) optional     m
+mesh_points                (p, 3) optional     mesh points, m (part frame, undeformed)
+mesh_cells                 (e, 4|10) optional  connectivity (int), meshio/VTK node order
+mesh_cell_type             str optional        ``tetra`` or ``tetra10``
+mode_shapes                (p, 3, n) optional  float32; nodal displacement per unit ξ, m, of
+                                               every orthonormal mode (rigid first),
+                                               ``u = mode_shapes @ ξ``; M-orthonormal
 info_json                  str                 provenance as JSON
 =========================  ==================  ===============================================
 """
@@ -69,6 +76,11 @@ def save_flexbody(path, body: FlexibleBody) -> Path:
     if body.stress_modes is not None:
         data["stress_modes"] = body.stress_modes
         data["stress_points"] = body.stress_points
+    if getattr(body, "mode_shapes", None) is not None:
+        data["mesh_points"] = np.asarray(body.mesh_points, float)
+        data["mesh_cells"] = np.asarray(body.mesh_cells)
+        data["mesh_cell_type"] = np.array(body.mesh_cell_type)
+        data["mode_shapes"] = body.mode_shapes
     # a unique temporary name (concurrent writers do not collide); through an open file, so
     # savez appends no ".npz" to a name that lacks it
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
@@ -107,4 +119,8 @@ def load_flexbody(path) -> FlexibleBody:
                         for i in range(1, 10)},
             stress_modes=z["stress_modes"] if "stress_modes" in z.files else None,
             stress_points=z["stress_points"] if "stress_points" in z.files else None,
+            mesh_points=z["mesh_points"] if "mode_shapes" in z.files else None,
+            mesh_cells=z["mesh_cells"] if "mode_shapes" in z.files else None,
+            mesh_cell_type=str(z["mesh_cell_type"]) if "mode_shapes" in z.files else None,
+            mode_shapes=z["mode_shapes"] if "mode_shapes" in z.files else None,
             info=json.loads(str(z["info_json"])), **kw)

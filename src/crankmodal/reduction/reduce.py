@@ -1,6 +1,7 @@
 """One call from an assembled model to a :class:`~crankmodal.reduction.flexbody.FlexibleBody`.
 
-interfaces → Craig–Bampton basis → orthonormalisation → invariants (→ stress modes).
+interfaces → Craig–Bampton basis → orthonormalisation → invariants (→ mesh, mode shapes and
+stress modes, when the mesh is given).
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ from .orthonormal import orthonormalise
 def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
                 cutoff_hz: float | None = None, backend: str = "auto", mesh=None,
                 stress_dtype=np.float32, name: str = "body",
-                info: dict | None = None) -> tuple[FlexibleBody, object]:
+                info: dict | None = None, stress: bool = True,
+                shape_dtype=np.float32) -> tuple[FlexibleBody, object]:
     """Reduce an FE model to a flexible body.
 
     Parameters
@@ -30,12 +32,18 @@ def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
     backend : str
         ``auto``, ``pardiso`` or ``superlu``.
     mesh : meshio.Mesh, optional
-        The part's mesh; when given, stress modes of every orthonormal mode are computed.
+        The part's mesh; when given, the body carries the mesh and the shapes of every
+        orthonormal mode on its nodes (``body.mode_shapes``), and (with ``stress``) their
+        stress modes.
     stress_dtype : numpy dtype
         Storage type of the stress modes.
     name : str
     info : dict, optional
         Provenance stored with the body.
+    stress : bool
+        Compute the stress modes when the mesh is given.
+    shape_dtype : numpy dtype
+        Storage type of the mode shapes.
 
     Returns
     -------
@@ -51,7 +59,7 @@ def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
     ortho = orthonormalise(cb.K, cb.M, Ra)
     timings["orthonormalise_s"] = time.perf_counter() - t0
     smodes = None
-    if mesh is not None:
+    if mesh is not None and stress:
         from .stress_modes import stress_modes, stress_recovery
 
         t0 = time.perf_counter()
@@ -62,7 +70,8 @@ def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
     body = flexible_body(model, cb, ortho, name=name, stress_modes=smodes,
                          info={**(info or {}), "backend": cb.backend,
                                "eigen_residual": cb.residual,
-                               "rigid_defect": ortho.rigid_defect})
+                               "rigid_defect": ortho.rigid_defect},
+                         mode_shapes=mesh is not None, shape_dtype=shape_dtype)
     timings["invariants_s"] = time.perf_counter() - t0
     body.info["timings_s"] = timings
     return body, cb
