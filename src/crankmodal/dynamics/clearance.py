@@ -88,7 +88,8 @@ class ClearanceJoint:
     bearing_length: float = 0.0
     film_model: str = "short"
     eps_max: float = 0.95
-    # contact memory (restitution laws): impact velocity of the current contact
+    # impact velocity of the current contact (restitution laws) for callers that do not pass
+    # one: the integrator keeps its own (simulate.integrate) and passes it to forces
     v_impact: float = 1e-3
     normal: laws.NormalLaw = field(init=False, repr=False)
     friction_law: laws.FrictionLaw = field(init=False, repr=False)
@@ -176,13 +177,18 @@ class ClearanceJoint:
         c, _ = self.bore_clearance(np.arctan2(ey, ex) - pb[2])
         return float(np.hypot(ex, ey)) - c
 
-    def forces(self, sysm, t, q, qd, Q):
-        """Add the contact forces to ``Q``; return the diagnostics and dissipated powers."""
+    def forces(self, sysm, t, q, qd, Q, v_impact=None):
+        """Add the contact forces to ``Q``; return the diagnostics and dissipated powers.
+
+        ``v_impact``: impact velocity of the contact in progress, m/s (restitution laws; floored
+        at ``v_impact_min``); None reads :attr:`v_impact`.
+        """
         k = self.kinematics(sysm, q, qd)
         delta, ddot = k["delta"], k["delta_dot"]
         if delta > 0.0:
             law = self.normal
-            fn = float(law.force(delta, ddot, max(self.v_impact, self.v_impact_min)))
+            v = self.v_impact if v_impact is None else v_impact
+            fn = float(law.force(delta, ddot, max(v, self.v_impact_min)))
             fel = float(law.elastic_force(delta))
             mu = float(self.friction_law.coefficient(k["v_slip"]))
         else:

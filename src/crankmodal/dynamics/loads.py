@@ -39,6 +39,7 @@ def tabulated_gas_force(angles_deg, forces_n, cycle_deg: float = 360.0) -> Calla
     def gas_force(angle: float) -> float:
         return float(np.interp(angle % period, xe, fe))
 
+    gas_force.table = (xe, fe, period)  # the same table, for the compiled right-hand side
     return gas_force
 
 

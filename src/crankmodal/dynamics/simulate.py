@@ -78,21 +78,21 @@ def _events(sysm, in_contact, memory):
     force, which output samples a few contact durations apart would miss."""
     n = sysm.n
     evs, tags = [], []
-    for j, cj in enumerate(sysm.clearances):
+    for j in range(len(sysm.clearances)):
         for kind, direction in (("on", 1.0), ("off", -1.0)):
             if memory and in_contact[j] == (kind == "on"):
                 continue
 
-            def g(t, y, cj=cj):
-                return cj.gap(sysm, y[:n])
+            def g(t, y, j=j):
+                return sysm.gap(j, y[:n])
 
             g.direction = direction
             g.terminal = memory
             evs.append(g)
             tags.append((j, kind))
 
-        def rate(t, y, cj=cj):
-            return cj.kinematics(sysm, y[:n], y[n:2 * n])["delta_dot"]
+        def rate(t, y, j=j):
+            return sysm.penetration_rate(j, y[:n], y[n:2 * n])
 
         rate.direction = -1.0
         rate.terminal = False
@@ -172,7 +172,7 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     atol = np.concatenate([np.full(n, settings.atol), np.full(n, settings.atol * settings.velocity_scale),
                            np.full(N_AUX, 1e-3)])
     memory = any(cj.needs_memory for cj in sysm.clearances)
-    in_contact = [cj.gap(sysm, q0) > 0.0 for cj in sysm.clearances]
+    in_contact = [sysm.gap(j, q0) > 0.0 for j in range(len(sysm.clearances))]
     onsets = [[] for _ in sysm.clearances]
     separations = [[] for _ in sysm.clearances]
     peaks = [[] for _ in sysm.clearances]
@@ -190,8 +190,16 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     pbar = bar(total=t_end, desc="dynamics", unit="s",
                bar_format="{desc}: {n:.3g}/{total:.3g} s simulated |{bar}| "
                           "[{elapsed}<{remaining}, {rate_noinv_fmt}]")
+    # the integrator's contact memory: per clearance joint the impact velocity of its contact
+    # in progress (restitution laws; constant between the restarts at onsets), passed to the
+    # right-hand side, not stored in the joints
+    v_impact = np.array([cj.v_impact_min for cj in sysm.clearances], float)
+
+    def rhs(t, y):
+        return sysm.rhs(t, y, v_impact)
+
     # a disabled bar (not a terminal, --quiet) leaves the right-hand side untouched
-    fun = sysm.rhs if pbar.disable else _progress_rhs(sysm.rhs, pbar)
+    fun = rhs if pbar.disable else _progress_rhs(rhs, pbar)
     while t < t_end:
         evs, tags = _events(sysm, in_contact, memory)
         te = None if own_steps else t_out[(t_out > t) & (t_out <= t_end)]
@@ -236,11 +244,11 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
                 if memory and te_k <= t:
                     continue
                 if kind == "peak":  # also fires at the widest free flight: keep contacts only
-                    if sysm.clearances[j].gap(sysm, ye_k[:n]) > 0.0:
+                    if sysm.gap(j, ye_k[:n]) > 0.0:
                         peaks[j].append((float(te_k), np.array(ye_k, float)))
                     continue
                 if kind == "on":
-                    v = sysm.clearances[j].kinematics(sysm, ye_k[:n], ye_k[n:2 * n])["delta_dot"]
+                    v = sysm.penetration_rate(j, ye_k[:n], ye_k[n:2 * n])
                     onsets[j].append((float(te_k), float(v)))
                 else:
                     separations[j].append(float(te_k))
@@ -248,10 +256,9 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
                     t_stop, fired = te_k, (j, kind, ye_k)
         if sol.status == 1 and fired is not None:
             j, kind, ye = fired
-            cj = sysm.clearances[j]
             in_contact[j] = kind == "on"
             if kind == "on":
-                cj.v_impact = max(onsets[j][-1][1], cj.v_impact_min)
+                v_impact[j] = max(onsets[j][-1][1], sysm.clearances[j].v_impact_min)
             t, y = float(t_stop), np.array(ye, float)
         else:
             t = t_end

@@ -43,10 +43,16 @@ class Multibody:
         m/s^2.
     baumgarte : float
         Stabilisation rate, 1/s.
+    compiled : bool
+        Evaluate :meth:`solve` and :meth:`rhs` with the Numba-compiled kernel of
+        :mod:`.compiled` when every part of the system has a compiled form (all-rigid bodies,
+        pins, sliders, drives, round dry clearance joints, piston loads, crank torques); the
+        generic Python path otherwise. The system must not be changed after its first
+        evaluation on the compiled path.
     """
 
     def __init__(self, bodies, constraints, clearances=(), loads=(), gravity=(0.0, 0.0),
-                 baumgarte=100.0):
+                 baumgarte=100.0, compiled=True):
         self.bodies = list(bodies)
         self.constraints = list(constraints)
         self.clearances = list(clearances)
@@ -81,6 +87,32 @@ class Multibody:
         self._drive_rows = np.zeros(self.m, bool)
         for c, r in zip(self.constraints, self.rows):
             self._drive_rows[r] = isinstance(c, AngleDrive)
+        self.compiled = compiled
+        self._kernel = None  # the compiled form, built at the first evaluation
+
+    def kernel(self):
+        """The :class:`~.compiled.CompiledSystem` of this system, or None (generic path)."""
+        if not self.compiled:
+            return None
+        if self._kernel is None:
+            from . import compiled
+
+            self._kernel = compiled.CompiledSystem(self) if compiled.applicable(self) else False
+        return self._kernel or None
+
+    def gap(self, j, q) -> float:
+        """Penetration of clearance joint ``j`` from positions only, m (event function)."""
+        k = self.kernel()
+        if k is None:
+            return self.clearances[j].gap(self, q)
+        return float(k.penetration(j, q)[0])
+
+    def penetration_rate(self, j, q, qd) -> float:
+        """Rate of penetration of clearance joint ``j``, m/s (event function)."""
+        k = self.kernel()
+        if k is None:
+            return self.clearances[j].kinematics(self, q, qd)["delta_dot"]
+        return float(k.penetration(j, q, qd)[1])
 
     # ----------------------------------------------------------------- body access
     def frame(self, body, frame, q, qd):
@@ -196,8 +228,15 @@ class Multibody:
         """Power dissipated by the flexible bodies' modal damping, W."""
         return sum(b.damping_power(qd[self.slices[id(b)]]) for b in self._elastic)
 
-    def solve(self, t, q, qd):
-        """Accelerations, multipliers and per-element diagnostics at one state."""
+    def solve(self, t, q, qd, v_impact=None):
+        """Accelerations, multipliers and per-element diagnostics at one state.
+
+        ``v_impact``: per clearance joint the impact velocity of its contact in progress, m/s
+        (restitution laws; the integrator's state); None reads each joint's ``v_impact``.
+        """
+        k = self.kernel()
+        if k is not None:
+            return k.solve(t, q, qd, v_impact)
         n = self.n
         self._fill_cache(q, qd)
         Q = np.zeros(n)
@@ -207,7 +246,8 @@ class Multibody:
         for b in self._elastic:
             s = self.slices[id(b)]
             Q[s] -= b.internal_forces(q[s], qd[s])
-        contacts = [cj.forces(self, t, q, qd, Q) for cj in self.clearances]
+        contacts = [cj.forces(self, t, q, qd, Q, None if v_impact is None else v_impact[j])
+                    for j, cj in enumerate(self.clearances)]
         p_loads = sum(ld.forces(self, t, q, qd, Q) for ld in self.loads)
         phi, Cq, nu, gamma = self.constraint_terms(t, q, qd)
         a = self.baumgarte
@@ -230,14 +270,20 @@ class Multibody:
         p_drive = float(p[self._drive_rows].sum())
         return p_drive, float(p.sum()) - p_drive
 
-    def rhs(self, t, y):
-        """Right-hand side of the first-order ODE in ``y``."""
+    def rhs(self, t, y, v_impact=None):
+        """Right-hand side of the first-order ODE in ``y`` (``v_impact``: see :meth:`solve`)."""
         self.nfev += 1
         if self.max_nfev is not None and self.nfev > self.max_nfev:
             raise BudgetExceeded(t)
+        k = self.kernel()
+        if k is not None:
+            dy = k.rhs(t, y, v_impact)
+            if dy is None:
+                raise NonFinite(t)
+            return dy
         n = self.n
         q, qd = y[:n], y[n: 2 * n]
-        out = self.solve(t, q, qd)
+        out = self.solve(t, q, qd, v_impact)
         p_drive, p_ideal = self.drive_power(out["lam"], out["Cq"], qd)
         p_damp = sum(c["p_damp"] for c in out["contacts"])
         p_fric = sum(c["p_fric"] for c in out["contacts"])

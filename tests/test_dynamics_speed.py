@@ -1,0 +1,115 @@
+"""The compiled right-hand side (crankmodal.dynamics.compiled) against the Python path.
+
+Oracle: the generic Python evaluation of the same system (``Multibody(compiled=False)``), state
+by state for every normal and friction law, and a whole smooth run (ideal joints: no impacts,
+so no chaotic amplification of round-off) sample by sample. Runs with impacts are not compared
+sample by sample: a 1e-9 change of rtol alone moves their impact sequence (see
+benchmarks/README.md); the closed-form impact tests of test_dynamics_contact run on the compiled
+path."""
+
+import numpy as np
+import pytest
+
+from crankmodal.dynamics import Cylinder, contact, crank_train, laws
+from crankmodal.dynamics.analysis import simulate
+from crankmodal.dynamics.bodies import Ground, RigidBody
+from crankmodal.dynamics.clearance import ClearanceJoint
+from crankmodal.dynamics.simulate import SolverSettings
+from crankmodal.dynamics.system import Multibody
+
+PARAMS = {"stiffness": 2e10, "exponent": 1.4, "damping": 800.0, "penetration": 5e-5,
+          "restitution": 0.7, "radial_clearance": 1e-4}
+FRICTION = {"mu_static": 0.12, "mu_dynamic": 0.08, "v_static": 1e-4, "v_dynamic": 1e-2}
+
+
+def _slider_crank(law, friction, params=PARAMS):
+    cyls = [Cylinder(axis_angle=a, rod_length=0.14, rod_mass=0.9, rod_inertia=3.1e-3,
+                     rod_com=0.042, piston_mass=0.75, ring_friction=30.0,
+                     gas_force=lambda x: 2000 + 1500 * np.cos(x)) for a in (0.0, 1.2)]
+    kw = {"law": law, "law_params": params, "friction": friction, "friction_params": FRICTION}
+    return crank_train(0.035, cyls, 3000.0, crank_mass=2.0, crank_inertia=0.01,
+                       clearances={"big_end_1": {"clearance": 1e-4, "journal_radius": 0.02}},
+                       contact_kw=kw, gravity=(0.0, -9.81))
+
+
+def _both(sysm, fn, *args):
+    sysm.compiled = False
+    a = fn(*args)
+    sysm.compiled = True
+    b = fn(*args)
+    return a, b
+
+
+@pytest.mark.parametrize("friction", contact.FRICTION_LAWS)
+@pytest.mark.parametrize("law", contact.NORMAL_LAWS)
+def test_compiled_rhs_and_solve_equal_the_python_path_state_by_state(law, friction):
+    mech = _slider_crank(law, friction)
+    sysm = mech.system
+    assert sysm.kernel() is not None
+    cj = sysm.clearances[0]
+    n = sysm.n
+    rng = np.random.default_rng(7)
+    in_contact = 0
+    for _ in range(12):
+        q = mech.q0 + rng.normal(0.0, 1.5e-4, n)
+        qd = mech.qd0 + rng.normal(0.0, 0.3, n)
+        t = rng.uniform(0.0, 0.05)
+        cj.v_impact = rng.uniform(0.01, 2.0)  # restitution laws read it at each call
+        y = np.concatenate([q, qd, np.zeros(6)])
+        py, co = _both(sysm, sysm.rhs, t, y)
+        scale = np.maximum(np.abs(py), 1e-300)
+        for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
+            np.testing.assert_allclose(co[blk], py[blk], rtol=0,
+                                       atol=1e-11 * np.max(scale[blk]) + 1e-300)
+        sp, sc = _both(sysm, sysm.solve, t, q, qd)
+        np.testing.assert_allclose(sc["lam"], sp["lam"], rtol=0,
+                                   atol=1e-11 * np.max(np.abs(sp["lam"])))
+        np.testing.assert_array_equal(sc["phi"], sp["phi"])
+        np.testing.assert_array_equal(sc["Cq"], sp["Cq"])
+        np.testing.assert_array_equal(sc["nu"], sp["nu"])
+        assert sc["p_loads"] == pytest.approx(sp["p_loads"], rel=1e-13, abs=1e-9)
+        kp, kc = sp["contacts"][0], sc["contacts"][0]
+        for key in ("delta", "delta_dot", "v_slip", "fn", "ft", "v_elastic", "p_damp", "p_fric",
+                    "d", "r_b", "omega_sum"):
+            assert kc[key] == pytest.approx(kp[key], rel=1e-12, abs=1e-12), key
+        for key in ("e", "n", "t", "force", "vrel", "Jj", "Jb"):
+            np.testing.assert_allclose(kc[key], kp[key], rtol=1e-12, atol=1e-15)
+        assert sysm.gap(0, q) == cj.gap(sysm, q)
+        assert sysm.penetration_rate(0, q, qd) == pytest.approx(
+            cj.kinematics(sysm, q, qd)["delta_dot"], rel=1e-14, abs=1e-16)
+        in_contact += kp["delta"] > 0.0 and kp["fn"] > 0.0
+    assert in_contact >= 3
+
+
+def test_a_smooth_run_is_the_same_on_both_paths():
+    # ideal joints (no impacts): the two paths' histories agree to round-off amplified by the
+    # integrator, with the same steps
+    runs = []
+    for compiled in (False, True):
+        mech = _slider_crank("impact", "coulomb")
+        mech.ideal.compiled = compiled
+        runs.append(simulate(mech, 0.04, 1e-4, SolverSettings(rtol=1e-8, atol=1e-12),
+                             ideal=True))
+    py, co = runs
+    assert co.nfev == py.nfev
+    scale = np.max(np.abs(py.main_bearing_force))
+    assert np.max(np.abs(co.main_bearing_force - py.main_bearing_force)) < 1e-9 * scale
+    np.testing.assert_allclose(co.piston_acceleration, py.piston_acceleration, rtol=0,
+                               atol=1e-9 * np.max(np.abs(py.piston_acceleration)))
+    for k in ("work_drive", "work_loads", "kinetic"):
+        np.testing.assert_allclose(co.energy[k], py.energy[k], rtol=0,
+                                   atol=1e-9 * np.max(np.abs(py.energy[k])))
+
+
+def test_what_has_no_compiled_form_stays_on_the_python_path():
+    ground = Ground(frames={"bore": (0.0, 0.0)})
+    journal = RigidBody("journal", 1.0, 1e-3, {"centre": (0.0, 0.0)})
+
+    def joint(**kw):
+        return ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
+                              journal_radius=0.01, law=laws.Hertz(stiffness=1e10), **kw)
+
+    assert Multibody([journal], [], [joint()]).kernel() is not None
+    assert Multibody([journal], [], [joint()], compiled=False).kernel() is None
+    assert Multibody([journal], [], [joint(clearance_major=2e-4)]).kernel() is None  # worn bore
+    assert Multibody([journal], [], [joint(viscosity=0.02, bearing_length=0.02)]).kernel() is None
