@@ -154,3 +154,21 @@ def test_markdown_cells_with_a_bar_keep_the_table_columns():
     rep.table(["section", "summary"], [["[mechanism]", "|F1| 2959 N"]])
     row = next(ln for ln in rep.to_markdown().splitlines() if ln.startswith("| [mechanism]"))
     assert row.replace("\\|", "").count("|") == 3  # two cells: three unescaped bars
+
+
+def test_a_static_scene_without_modal_reports_part_material_and_stress_with_its_render(tmp_path):
+    """[report] no longer needs [modal] (issue 20): geometry, material and static each get their
+    section; the von Mises render (own camera) is embedded in the static one."""
+    scene = _scene(tmp_path, {})
+    del scene.sections["modal"]
+    res = run(scene, tmp_path / "out")
+    html = (tmp_path / "out" / "report.html").read_text()
+    heads = re.findall(r"<h2>(.*?)</h2>", html)
+    assert [h for h in heads if h.endswith("]")] == ["Part and mesh [geometry]",
+                                                     "Material [material]",
+                                                     "Static stress [static]"]
+    static = html.split("<h2>Static stress [static]</h2>")[1].split("<h2>")[0]
+    assert static.count("<img ") == 1 and f"{res['static']['max_von_mises_pa'] / 1e6:.4g}" in static
+    assert res["report"]["von_mises_render"] == "von_mises.png"
+    assert re.search(r"<h1>Report: ", html) and res["report"]["sections"] == ["geometry",
+                                                                              "material", "static"]

@@ -48,9 +48,6 @@ def scene_title(scene, params: dict, results: dict) -> str:
     stages = [s for s in results if s in TITLES and s not in ("geometry", "material")]
     machine = machine_name(params)
     head = machine or scene.name
-    part = (params.get("geometry") or {}).get("part") if "geometry" in params else None
-    if machine and part:
-        head += f" ({part})"
     return f"{head}: {', '.join(stages)}" if stages else head
 
 
@@ -65,6 +62,8 @@ def fmt(v, unit: str = "", scale: float = 1.0, digits: int = 4) -> str | None:
         if not v:
             return None
         return ", ".join(fmt(x, "", scale, digits) or "–" for x in v) + (f" {unit}" if unit else "")
+    if isinstance(v, int) and scale == 1.0:
+        return str(v) + (f" {unit}" if unit else "")
     if isinstance(v, (int, float)):
         return f"{v * scale:.{digits}g}" + (f" {unit}" if unit else "")
     return str(v)
@@ -267,7 +266,11 @@ def dynamics_blocks(report: Report, res: dict) -> None:
              None]]
     report.paragraph(f"{res.get('mechanism', '')} at {fmt(res.get('speed_rpm'), 'rpm')}, "
                      f"{fmt(res.get('end_time_s'), 's')} simulated.")
-    report.table(["quantity", "this run", "ideal joints"], [r for r in rows if r[1] is not None])
+    rows = [r for r in rows if r[1] is not None]
+    if ideal:
+        report.table(["quantity", "this run", "ideal joints"], rows)
+    else:
+        report.table(["quantity", "value"], [r[:2] for r in rows])
     joints = res.get("clearance_joints") or {}
     if joints:
         report.heading("Clearance joints", level=3)
@@ -344,7 +347,27 @@ def _max_deflection_um(d) -> str | None:
     return fmt(max(vals), scale=1e6, digits=3) if vals else None
 
 
-STAGE_BLOCKS = {"static": static_blocks, "reduction": reduction_blocks,
+def geometry_blocks(report: Report, res: dict) -> None:
+    """The part and its mesh (a scene without [modal]; with it the modal section has them)."""
+    q = res.get("quality") or {}
+    rows = _rows(res, (("name", "part", "", 1.0), ("fidelity", "fidelity", "", 1.0),
+                       ("element_order", "element order", "", 1.0),
+                       ("n_elements", "elements", "", 1.0), ("n_nodes", "nodes", "", 1.0)))
+    if q.get("measure"):
+        rows.append([f"quality ({q['measure']}) min / mean", f"{q['min']:.3f} / {q['mean']:.3f}"])
+    report.table(["quantity", "value"], rows)
+
+
+def material_blocks(report: Report, res: dict) -> None:
+    """The material's constants (a scene without [modal])."""
+    report.table(["quantity", "value"], _rows(res, (
+        ("name", "name", "", 1.0), ("E_pa", "E", "GPa", 1e-9), ("nu", "ν", "", 1.0),
+        ("rho_kg_m3", "ρ", "kg/m³", 1.0), ("yield_strength_pa", "yield strength", "MPa", 1e-6),
+        ("ultimate_strength_pa", "ultimate strength", "MPa", 1e-6))))
+
+
+STAGE_BLOCKS = {"geometry": geometry_blocks, "material": material_blocks,
+                "static": static_blocks, "reduction": reduction_blocks,
                 "torsion": torsion_blocks, "mechanism": mechanism_blocks,
                 "dynamics": dynamics_blocks}
 

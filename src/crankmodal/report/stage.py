@@ -145,7 +145,8 @@ def run(p: dict, ctx) -> dict:
     out: dict = {}
     title = p["title"]
     if title is None:
-        title = (f"Modal report: {part.name} ({part.fidelity}, P{part.element_order})"
+        kind = "Modal report" if "modal" in results else "Report"
+        title = (f"{kind}: {part.name} ({part.fidelity}, P{part.element_order})"
                  if fe_only and part is not None
                  else scene_title(ctx.scene, ctx.params, results))
     rep = Report(title)
@@ -155,11 +156,16 @@ def run(p: dict, ctx) -> dict:
     rep.table(["section", "wall time, s", "verdict"], overview_rows(results))
     modal = _modal_section(p, ctx, rep, results, out) if "modal" in ctx.params else None
     for section, res in results.items():
-        if section in MODAL_SECTIONS or section == SECTION:
+        if (modal is not None and section in MODAL_SECTIONS) or section == SECTION:
             continue
         images = []
-        if section == "static" and modal and modal.get("von_mises"):
-            images.append((modal["von_mises"], "von Mises stress on the deformed shape"))
+        vm = modal.get("von_mises") if modal else None
+        if section == "static" and vm is None and modal is None:
+            vm = _static_render(p, ctx)
+            if vm is not None:
+                out["von_mises_render"] = relative_name(vm, out_dir)
+        if section == "static" and vm is not None:
+            images.append((vm, "von Mises stress on the deformed shape"))
         stage_section(rep, section, res, out_dir, images=images)
     if p["study"]:
         _study(p, ctx, rep, out, modal["measured"] if modal else None)
@@ -263,6 +269,20 @@ def _modal_section(p, ctx, rep, results, out) -> dict:
 
 
 MODAL_ORDER = ("geometry", "material", "modal")
+
+
+def _static_render(p, ctx):
+    """``von_mises.png`` of a scene with [static] but no [modal] (its own camera), or None."""
+    part, static = ctx.products.get("geometry"), ctx.products.get("static")
+    if not (p["renders"] and p["stress"] and ctx.figures and part is not None
+            and static is not None):
+        return None
+    from .render import boundary_surface, part_camera, render_scalar
+
+    surf = boundary_surface(part.mesh.points, part.mesh.cells[0].data)
+    return render_scalar(surf, static.von_mises, ctx.out_dir / "von_mises.png",
+                         f"von Mises stress, max {static.max_von_mises / 1e6:.4g} MPa",
+                         part_camera(surf.points), displacement=static.displacement)
 
 
 def to_jsonable_summary(part) -> dict:
