@@ -255,3 +255,22 @@ def test_a_body_struck_in_exudyn_rings_at_crankmodals_frequency(reduced):
     assert np.abs(x).max() * w == pytest.approx(1.0, rel=1e-3)
     assert np.abs(data[:, 2:]).max() < 1e-9 * np.abs(x).max()
     assert np.abs(mbs.GetSensorStoredData(s_rb)[:, 1:]).max() < 1e-9 * np.abs(x).max()
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_surface_equals_exudyns_volume_to_surface_elements(order):
+    """The vectorised surface is Exudyn's own (same triangles, node order and sequence)."""
+    pytest.importorskip("exudyn")
+    from exudyn.FEM import FEMinterface
+
+    part = bar(0.2, 0.03, 0.02, (4, 2, 1), order=order)
+    cells = np.asarray(part.mesh.cells[0].data)
+    fem = FEMinterface()
+    fem.nodes = {"Position": np.asarray(part.mesh.points, float)}
+    fem.elements = [{"Name": "bar", "Tet10" if order == 2 else "Tet4": cells}]
+    fem.VolumeToSurfaceElements()
+    mine = export.exudyn_surface(cells)
+    assert np.array_equal(mine["Trigs"], fem.surface[0]["Trigs"])
+    assert ("Trigs6" in mine) == ("Trigs6" in fem.surface[0]) == (order == 2)
+    if order == 2:
+        assert np.array_equal(mine["Trigs6"], fem.surface[0]["Trigs6"])

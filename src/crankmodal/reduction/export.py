@@ -50,6 +50,47 @@ from .flexbody import FlexibleBody
 _EXUDYN_CELLS = {"tetra": "Tet4", "tetra10": "Tet10"}
 
 
+#: Exudyn's faces of a tetrahedron (``FEMinterface.VolumeToSurfaceElements``), in its order.
+_EXUDYN_TET_FACES = np.array([[0, 1, 2], [0, 3, 1], [1, 3, 2], [2, 3, 0]])
+#: Local mid node of a tetra10 edge (meshio order = Exudyn's Tet10: 01, 12, 02, 03, 13, 23).
+_TET10_MID = np.full((4, 4), -1)
+for _k, (_a, _b) in enumerate(((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))):
+    _TET10_MID[_a, _b] = _TET10_MID[_b, _a] = 4 + _k
+
+
+def exudyn_surface(cells: np.ndarray) -> dict:
+    """The boundary triangles Exudyn's ``FEMinterface.VolumeToSurfaceElements`` makes, vectorised.
+
+    Same triangles, node order and sequence (element by element, faces in Exudyn's order), in
+    milliseconds instead of Exudyn's pure-Python neighbour search (72 s on a 20 728-element
+    tetra10 connecting rod).
+
+    Parameters
+    ----------
+    cells : ndarray of int, shape (e, 4 or 10)
+        tetra or tetra10 connectivity (meshio order).
+
+    Returns
+    -------
+    dict
+        ``{"Name": "meshSurface", "Trigs": (t, 3)}`` plus ``"Trigs6"`` (t, 6) for tetra10
+        (corners, then the mid nodes of edges 01, 12, 20).
+    """
+    cells = np.asarray(cells, int)
+    faces = cells[:, _EXUDYN_TET_FACES].reshape(-1, 3)  # element-major, Exudyn's face order
+    _, inv, counts = np.unique(np.sort(faces, axis=1), axis=0, return_inverse=True,
+                               return_counts=True)
+    keep = np.flatnonzero(counts[inv.ravel()] == 1)
+    out = {"Name": "meshSurface", "Trigs": faces[keep]}
+    if cells.shape[1] == 10:
+        el, fk = np.divmod(keep, 4)
+        loc = _EXUDYN_TET_FACES[fk]  # (t, 3) local corners
+        mids = np.stack([cells[el, _TET10_MID[loc[:, a], loc[:, b]]]
+                         for a, b in ((0, 1), (1, 2), (2, 0))], axis=1)
+        out["Trigs6"] = np.hstack([faces[keep], mids])
+    return out
+
+
 def _need_mesh(body: FlexibleBody, what: str) -> None:
     if not body.has_mesh:
         raise ValueError(f"{what}: flexible body {body.name!r} carries no mesh and mode shapes "
@@ -143,7 +184,7 @@ def exudyn_fem_interface(body: FlexibleBody, model=None, stress: bool = True):
     fem.nodes = {"Position": pts}
     fem.elements = [{"Name": body.name,
                      _EXUDYN_CELLS[body.mesh_cell_type]: np.asarray(body.mesh_cells, int)}]
-    fem.VolumeToSurfaceElements()
+    fem.surface = [exudyn_surface(body.mesh_cells)]  # = fem.VolumeToSurfaceElements(), fast
     fem.modeBasis = {"matrix": elastic_shapes(body), "type": "NormalModes"}
     fem.eigenValues = np.diag(body.stiffness)[~body.rigid].copy()
     if model is not None:
