@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from scipy.linalg.lapack import dgesv as _gesv
 
 from .bodies import Ground, RigidBody
 from .clearance import ClearanceJoint
@@ -520,6 +521,7 @@ class CompiledSystem:
         self.vimp = np.zeros(nc)
         self._diag = np.zeros((nc, len(DIAG)))
         self._kin = np.zeros(len(DIAG))
+        self._zeros = np.zeros(self.n)
         self._scratch = (np.empty(self.m), np.empty(self.m), np.empty((self.m, self.n)),
                          np.zeros(5))
         nb = int(np.count_nonzero(mdiag == 0.0))
@@ -543,9 +545,13 @@ class CompiledSystem:
         Q, cqd, A, rhs = self._work
         assemble(t, q, qd, dv, self.vimp, self.gas_py, self.I, self.io, self.F, self.fo, phi, Cq,
                  diag, powers, Q, cqd, A, rhs)
-        # the solve in NumPy (LAPACK gesv, as on the Python path): compiling np.linalg.solve
-        # would cost more at the first run than calling it from here costs in a whole run
-        sol = np.linalg.solve(A, rhs)
+        # LAPACK gesv (as np.linalg.solve on the Python path) through SciPy's thin wrapper, in
+        # place: compiling np.linalg.solve would cost 10 s more at the first run, and NumPy's
+        # own wrapper twice the time of this call. A is symmetric, so its transpose is the
+        # Fortran-ordered A that gesv overwrites without a copy.
+        _, _, sol, info = _gesv(A.T, rhs, overwrite_a=True, overwrite_b=True)
+        if info > 0:
+            raise np.linalg.LinAlgError("Singular matrix")
         return finish(sol, Q, Cq, cqd, self.I, self.io, self.F, self.fo, qdd, lam, powers)
 
     def rhs(self, t, y, v_impact=None):
@@ -611,7 +617,7 @@ class CompiledSystem:
         """``(delta, delta_dot)`` of clearance joint ``j`` (``delta_dot`` 0 without ``qd``)."""
         out = self._kin
         q = np.ascontiguousarray(q, float)
-        qd = np.zeros_like(q) if qd is None else np.ascontiguousarray(qd, float)
+        qd = self._zeros if qd is None else np.ascontiguousarray(qd, float)
         clearance_kinematics(j, q, qd, self.I, self.io, self.F, self.fo, out)
         return out[5], out[6]
 

@@ -12,8 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contact import step
-
 
 @dataclass
 class Revolute:
@@ -91,7 +89,9 @@ class SpeedProfile:
     def speed(self, t: float) -> float:
         if self.ramp_time <= 0.0:
             return self.omega
-        return float(step(t, 0.0, self.omega_start, self.ramp_time, self.omega))
+        # contact.step in scalar arithmetic (the same operations, without NumPy's call costs)
+        s = self._s(t)
+        return self.omega_start + (self.omega - self.omega_start) * s * s * (3.0 - 2.0 * s)
 
     def acceleration(self, t: float) -> float:
         if self.ramp_time <= 0.0 or t >= self.ramp_time or t <= 0.0:
