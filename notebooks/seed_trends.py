@@ -11,18 +11,23 @@
 # (e) seed 001: loom coupler-pin journal trace, bearing-force direction, Table 3;
 # (f) seed 003: impact velocity in a worn (elliptical) big end rising with wear.
 #
-# Run time about 5 min on one core. Not part of the default test run (tests/test_notebooks.py
-# skips notebooks marked ``# crankmodal: slow-notebook``); the asserted trends are the slow
-# tests in ``tests/test_dynamics_seed_trends.py``.
+# Run time about 5 min on one core. Not part of the default test run: notebooks marked
+# ``# crankmodal: slow-notebook`` run with ``pytest -m slow tests/test_notebooks.py``; the
+# asserted trends are the slow tests in ``tests/test_dynamics_seed_trends.py``. Run from inside
+# the source tree (Jupyter in ``notebooks/``, or ``python notebooks/seed_trends.py``) it updates
+# ``docs/img``; anywhere else it writes the figures and numbers to ``./seed_trends_out``.
 # crankmodal: slow-notebook
 
 # %%
 import json
+import sys
 import time
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 
+import crankmodal as cm
 from crankmodal.dynamics.analysis import simulate
 from crankmodal.dynamics.build import build_mechanism, solver_settings
 from crankmodal.dynamics.reynolds import steady_bearing
@@ -35,14 +40,30 @@ from crankmodal.dynamics.signals import (
     window_peaks,
 )
 from crankmodal.dynamics.simulate import integrate
-from crankmodal.plotting import pyplot
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
 
-ROOT = Path(__file__).resolve().parent.parent
-IMG = ROOT / "docs" / "img"
+
+def source_tree() -> Path | None:
+    """The crankmodal checkout the notebook runs in (cwd or a parent holding pyproject.toml and
+    docs/img), else None."""
+    for d in (Path.cwd(), *Path.cwd().parents):
+        if (d / "pyproject.toml").is_file() and (d / "docs" / "img").is_dir():
+            return d
+    return None
+
+
+def done(fig):
+    """Show a saved figure inline in Jupyter; in a plain script, just release it."""
+    if "ipykernel" in sys.modules:
+        plt.show()
+    else:
+        plt.close(fig)
+
+
+ROOT = source_tree()
+IMG = ROOT / "docs" / "img" if ROOT else Path.cwd() / "seed_trends_out"
 IMG.mkdir(parents=True, exist_ok=True)
-plt = pyplot()
 T_START = time.perf_counter()
 RESULTS = {}
 
@@ -50,7 +71,7 @@ RESULTS = {}
 def run_scene(scene, overrides, ideal=False, dt=None):
     """Mechanism and history of a scene with overrides (output every ``dt`` s, default 0.5 deg
     of crank)."""
-    params = check(load_scene(ROOT / "scenes" / scene, overrides))
+    params = check(load_scene(cm.scene_path(Path(scene).stem), overrides))
     p = params["dynamics"]
     mech = build_mechanism(p, params.get("mechanism"))
     h = simulate(mech, p["end_time"], dt or 1.0 / (720 * mech.revolution_hz),
@@ -150,7 +171,7 @@ for j, (c, (r, h, spec, sel)) in enumerate(runs_c.items()):
 fig.suptitle("Seed 000 Fig. 24: first-stage piston, 1480 rpm, IMPACT + Coulomb")
 fig.tight_layout()
 fig.savefig(IMG / "dyn_clearance_acceleration.png", dpi=110)
-plt.close(fig)
+done(fig)
 
 fig, ax = plt.subplots(figsize=(9, 4.5))
 for c, (r, h, spec, sel) in runs_c.items():
@@ -161,7 +182,7 @@ ax.set(xlim=(0, 2000), ylim=(1e-1, None), xlabel="frequency (Hz)", ylabel="|F_x|
 ax.legend()
 fig.tight_layout()
 fig.savefig(IMG / "dyn_clearance_spectrum.png", dpi=110)
-plt.close(fig)
+done(fig)
 
 # %% [markdown]
 # ### (b): 148 / 740 / 1480 rpm at 0.10 mm (seed 000 Fig. 25)
@@ -226,7 +247,7 @@ for j, rpm in enumerate(sorted(runs_n)):
 fig.suptitle("Seed 000 Fig. 25: clearance 0.10 mm at three speeds (IMPACT + Coulomb, Table 4)")
 fig.tight_layout()
 fig.savefig(IMG / "dyn_speed_acceleration.png", dpi=110)
-plt.close(fig)
+done(fig)
 
 # %% [markdown]
 # ### (d): friction off / on at 0.10 mm, 1480 rpm (seed 000 Figs. 19/20)
@@ -317,7 +338,7 @@ fig.suptitle("Seed 000 Figs. 19/20: 1480 rpm, 0.10 mm, with and without friction
              f"({N_REV_D} revolutions, Hann)")
 fig.tight_layout()
 fig.savefig(IMG / "dyn_friction_spectrum.png", dpi=110)
-plt.close(fig)
+done(fig)
 
 # %% [markdown]
 # ## (e) Seed 001: loom four-bar, lubricated coupler pin C
@@ -358,7 +379,7 @@ SEED001 = {"min_force_n": 20.0, "min_force_crank_deg": 92.0,
            "fast_direction_crank_deg": [92.0, 322.0],
            "inside_eps_0p1_crank_deg": [[72, 114], [178, 192], [302, 338]],
            "eps_min_at_92_and_322": [0.001, 0.004]}
-LOOM = ROOT / "scenes" / "loom_four_bar_dynamics.toml"
+LOOM = cm.scene_path("loom_four_bar_dynamics")
 NEAR = {"92": (40.0, 140.0), "322": (250.0, 359.5)}   # crank-angle windows of the two events, deg
 
 
@@ -509,7 +530,7 @@ for ax in (ax2, ax3):
 ax3.legend(fontsize=7)
 fig.tight_layout()
 fig.savefig(IMG / "dyn_loom_journal.png", dpi=110)
-plt.close(fig)
+done(fig)
 
 # %% [markdown]
 # ## (f) Seed 003: worn, elliptical big end
@@ -584,7 +605,7 @@ ax2.set(aspect="equal", xlabel="journal centre along the rod axis (mm)", ylabel=
 ax2.legend(fontsize=8, loc="upper right")
 fig.tight_layout()
 fig.savefig(IMG / "dyn_worn_impact_velocity.png", dpi=110)
-plt.close(fig)
+done(fig)
 
 # %%
 RESULTS["run_time_s"] = time.perf_counter() - T_START

@@ -52,3 +52,10 @@ def test_the_core_objects_the_readme_composes_are_the_expected_kinds():
     assert crankmodal.Cylinder.__module__ == "crankmodal.dynamics.mechanisms"
     assert issubclass(crankmodal.SceneError, crankmodal.CrankmodalError)
     assert callable(crankmodal.run_scene) and callable(crankmodal.select_supports)
+
+
+def test_a_subpackage_not_yet_imported_is_reachable_as_an_attribute():
+    out = _fresh("import crankmodal, json; "
+                 "print(json.dumps([crankmodal.resources.__name__, "
+                 "crankmodal.scene_path('seed004_torsion').name]))")
+    assert json.loads(out) == ["crankmodal.resources", "seed004_torsion.toml"]

@@ -29,6 +29,7 @@ _EXPORTS: dict[str, tuple[str, str]] = {
     "check_scene": ("crankmodal.runner", "check"),
     "run_scene": ("crankmodal.runner", "run"),
     "list_machines": ("crankmodal.resources", "list_machines"),
+    "scene_path": ("crankmodal.resources", "scene_path"),
     "load_machine": ("crankmodal.resources", "load_machine"),
     # errors
     "CrankmodalError": ("crankmodal.errors", "CrankmodalError"),
@@ -178,6 +179,7 @@ __all__ = [
     "run_scene",
     "save_flexbody",
     "scene_from_dict",
+    "scene_path",
     "select_supports",
     "simulate",
     "solve_modes",
@@ -192,6 +194,11 @@ def __getattr__(name: str):
     try:
         module, attr = _EXPORTS[name]
     except KeyError:
+        # a subpackage or module not imported yet (``crankmodal.dynamics``), as after an import
+        from importlib.util import find_spec
+
+        if not name.startswith("_") and find_spec(f"{__name__}.{name}") is not None:
+            return import_module(f"{__name__}.{name}")
         raise AttributeError(f"module 'crankmodal' has no attribute {name!r}") from None
     value = getattr(import_module(module), attr)
     globals()[name] = value  # later accesses skip this function
