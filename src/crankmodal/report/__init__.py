@@ -3,7 +3,8 @@
 Modules: :mod:`.mac` (modal assurance criterion), :mod:`.render` (off-screen pyvista
 mode-shape and stress renders), :mod:`.plots` (matplotlib figures with CSV data),
 :mod:`.study` (fidelity x mesh size x element order studies, Pareto front, recommendation),
-:mod:`.modal_report` (self-contained HTML and Markdown), :mod:`.testing`
+:mod:`.modal_report` (self-contained HTML and Markdown), :mod:`.scene_report` (the report of
+the whole scene: a section per stage with its verdict, tables and figures), :mod:`.testing`
 (``assert_frequencies`` for users' test suites), :mod:`.stage` (the ``[report]`` section).
 Nothing heavy is imported here.
 """
