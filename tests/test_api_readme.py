@@ -32,11 +32,26 @@ def test_api_blocks_are_found_in_a_section_and_only_there():
     assert api_blocks("# no such section\n```python\nA\n```\n") == []
 
 
-def test_readme_python_api_examples_run(tmp_path, monkeypatch):
+def _readme_blocks() -> list[str]:
     blocks = api_blocks(README.read_text(encoding="utf-8"))
     if not blocks:
         pytest.skip(f"README.md has no '{HEADING}' section with python blocks yet "
                     "(its text is in /work/helpers/readme_C.md until merged)")
+    return blocks
+
+
+def test_readme_python_api_uses_only_the_exported_names():
+    import crankmodal
+
+    code = "\n".join(_readme_blocks())
+    assert "import crankmodal as cm" in code
+    used = set(re.findall(r"\bcm\.(\w+)", code))
+    assert used and used <= set(crankmodal.__all__), sorted(used - set(crankmodal.__all__))
+    assert not re.search(r"^\s*(from|import) crankmodal\.", code, re.MULTILINE)
+
+
+def test_readme_python_api_examples_run(tmp_path, monkeypatch):
+    blocks = _readme_blocks()
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MPLBACKEND", os.environ.get("MPLBACKEND", "Agg"))
     namespace: dict = {"__name__": "readme_python_api"}
