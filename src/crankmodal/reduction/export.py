@@ -274,3 +274,46 @@ def exudyn_ffrf_interface(body: FlexibleBody,
     cms.massMatrixFFRFreduced[0:3, 0:3] = cms.Mtt
     cms.massMatrixFFRFreduced[cms.nODE2rigid:, cms.nODE2rigid:] = cms.massMatrixReduced
     return cms
+
+
+def exudyn_interface_marker(mbs, object_number, body: FlexibleBody, name: str, **kwargs):
+    """An Exudyn rigid marker at one of the body's interface nodes, for joints and loads.
+
+    A ``MarkerSuperElementRigid`` on the interface's surface nodes, weighted by the area each
+    carries (``body.interface_weights``, the weights of crankmodal's distributing coupling),
+    with its offset moving it from their weighted mean to the interface centre (the exact bore
+    centre; the offset is 0 for a full bore).
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    object_number : exudyn.ObjectIndex
+        The ``ObjectFFRFreducedOrder`` (``cms.AddObjectFFRFreducedOrder(mbs)["oFFRFreducedOrder"]``).
+    body : FlexibleBody
+        The same body, with its mesh (files written before the interface nodes were stored
+        cannot place markers).
+    name : str
+        Interface name (``body.interface_names``).
+    **kwargs
+        Passed on to ``MarkerSuperElementRigid`` (e.g. ``useAlternativeApproach``).
+
+    Returns
+    -------
+    exudyn.MarkerIndex
+    """
+    import exudyn.itemInterface as eii
+
+    if name not in body.interface_names:
+        raise ValueError(f"exudyn_interface_marker: no interface {name!r} in body {body.name!r}; "
+                         f"interfaces: {', '.join(body.interface_names)}")
+    if body.interface_nodes is None or body.interface_weights is None:
+        raise ValueError(f"exudyn_interface_marker: body {body.name!r} stores no interface nodes "
+                         "(reduce it with the mesh, as the [reduction] stage does)")
+    r = body.interface_names.index(name)
+    nodes, w = np.asarray(body.interface_nodes[r]), np.asarray(body.interface_weights[r], float)
+    keep = w > 1e-12 * w.max()  # the corners of flat P2 triangles carry no area
+    nodes, w = nodes[keep], w[keep] / w[keep].sum()
+    offset = np.asarray(body.interface_centres[r]) - w @ np.asarray(body.mesh_points)[nodes]
+    return mbs.AddMarker(eii.MarkerSuperElementRigid(
+        bodyNumber=object_number, meshNodeNumbers=[int(i) for i in nodes],
+        weightingFactors=w.tolist(), offset=offset.tolist(), **kwargs))

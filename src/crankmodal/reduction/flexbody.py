@@ -91,6 +91,11 @@ class FlexibleBody:
         Nodal displacement (m) per unit modal coordinate ``ξ`` of every orthonormal mode (rigid
         first): ``u = mode_shapes @ ξ``; M-orthonormal against the FE mass matrix, stored as
         float32.
+    interface_nodes : list of ndarray of int or None
+        Per interface, the mesh points of its surface, sorted (with the mesh only).
+    interface_weights : list of ndarray or None
+        Per interface, ``∫_Γ N_a dA`` of each of those points, m² (the area each node carries;
+        0 at the corners of P2 triangles): weights for a distributing (RBE3-like) coupling.
     info : dict
         Provenance (part, material, coupling, timings).
     """
@@ -122,6 +127,8 @@ class FlexibleBody:
     mesh_cells: np.ndarray | None = None
     mesh_cell_type: str | None = None
     mode_shapes: np.ndarray | None = None
+    interface_nodes: list | None = None
+    interface_weights: list | None = None
 
     @property
     def n_modes(self) -> int:
@@ -227,6 +234,7 @@ def flexible_body(model, cb, ortho, name: str = "body", stress_modes=None,
     K = W.T @ cb.K @ W
     Mm = W.T @ cb.M @ W
     mp = ortho.mass_props
+    areas = _interface_areas(model, cb.interfaces) if mode_shapes else None
     return FlexibleBody(
         name=name, frequencies_hz=ortho.frequencies_hz, stiffness=np.diag(ortho.eigenvalues),
         mass=np.eye(n), rigid=ortho.rigid,
@@ -244,6 +252,19 @@ def flexible_body(model, cb, ortho, name: str = "body", stress_modes=None,
         mesh_cell_type=("tetra10" if model.order == 2 else "tetra") if mode_shapes else None,
         mode_shapes=((cb.V @ W).reshape(len(model.points), 3, n).astype(shape_dtype)
                      if mode_shapes else None),
+        interface_nodes=[a for a, _ in areas] if mode_shapes else None,
+        interface_weights=[w for _, w in areas] if mode_shapes else None,
         info={**(info or {}), "k_modal_offdiag": float(np.abs(K - np.diag(np.diag(K))).max()
                                                        / max(np.abs(np.diag(K)).max(), 1e-300)),
               "m_orthonormality": float(np.abs(Mm - np.eye(n)).max())})
+
+
+def _interface_areas(model, interfaces) -> list:
+    """Per interface: (sorted surface nodes, ``∫_Γ N_a dA`` of each, m²)."""
+    from .interfaces import surface_mass
+
+    out = []
+    for i in interfaces:
+        nodes, Ms = surface_mass(model.points, i.facets, model.cells)
+        out.append((np.asarray(nodes, int), np.asarray(Ms.sum(axis=1)).ravel()))
+    return out

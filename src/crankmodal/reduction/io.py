@@ -37,6 +37,9 @@ mesh_cell_type             str optional        ``tetra`` or ``tetra10``
 mode_shapes                (p, 3, n) optional  float32; nodal displacement per unit ξ, m, of
                                                every orthonormal mode (rigid first),
                                                ``u = mode_shapes @ ξ``; M-orthonormal
+interface_node_counts      (m,) optional       mesh points of each interface's surface …
+interface_nodes            (Σ,) optional       … concatenated (int; split by the counts)
+interface_weights          (Σ,) optional       ``∫_Γ N_a dA`` of those points, m²
 info_json                  str                 provenance as JSON
 =========================  ==================  ===============================================
 """
@@ -81,6 +84,11 @@ def save_flexbody(path, body: FlexibleBody) -> Path:
         data["mesh_cells"] = np.asarray(body.mesh_cells)
         data["mesh_cell_type"] = np.array(body.mesh_cell_type)
         data["mode_shapes"] = body.mode_shapes
+        nodes = getattr(body, "interface_nodes", None)
+        if nodes is not None:
+            data["interface_node_counts"] = np.array([len(a) for a in nodes], int)
+            data["interface_nodes"] = np.concatenate(nodes).astype(int)
+            data["interface_weights"] = np.concatenate(body.interface_weights).astype(float)
     # a unique temporary name (concurrent writers do not collide); through an open file, so
     # savez appends no ".npz" to a name that lacks it
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
@@ -123,4 +131,9 @@ def load_flexbody(path) -> FlexibleBody:
             mesh_cells=z["mesh_cells"] if "mode_shapes" in z.files else None,
             mesh_cell_type=str(z["mesh_cell_type"]) if "mode_shapes" in z.files else None,
             mode_shapes=z["mode_shapes"] if "mode_shapes" in z.files else None,
+            interface_nodes=(np.split(z["interface_nodes"], np.cumsum(z["interface_node_counts"])[:-1])
+                             if "interface_nodes" in z.files else None),
+            interface_weights=(np.split(z["interface_weights"],
+                                        np.cumsum(z["interface_node_counts"])[:-1])
+                               if "interface_weights" in z.files else None),
             info=json.loads(str(z["info_json"])), **kw)
