@@ -137,3 +137,20 @@ def test_every_render_carries_the_xyz_axis_triad_in_its_lower_left_corner(tmp_pa
         assert np.sum((g > r + 40) & (g > b + 20)) > 10, path  # y axis
         assert np.sum((r > g + 80) & (r > b + 80)) > 10, path  # x axis
         assert np.sum((b > r + 80) & (b > g + 80)) > 10, path  # z axis
+
+
+def test_a_stress_peak_at_an_undrawn_node_is_said_under_the_render():
+    """The seed 000 rod's von Mises render said "max 25.5 MPa" in its title while its colour bar
+    stopped at 19.8 MPa: the peak sits at a P2 mid-side node, which the surface does not draw."""
+    from crankmodal.report.render import undrawn_peak_note
+
+    part = testparts.bar(0.3, 0.03, 0.02, divisions=(4, 1, 1), order=2)
+    surf = boundary_surface(part.mesh.points, part.mesh.cells[0].data)
+    corners = np.unique(part.mesh.cells[0].data[:, :4])
+    mid = np.setdiff1d(np.arange(len(part.mesh.points)), corners)[0]
+    v = np.ones(len(part.mesh.points))
+    v[mid] = 25.5
+    note = undrawn_peak_note(v, v[surf.node_ids])
+    assert note is not None and "up to 1;" in note and "25.5" in note
+    v[corners[0]] = 25.5  # the maximum on a drawn node too: nothing to say
+    assert undrawn_peak_note(v, v[surf.node_ids]) is None

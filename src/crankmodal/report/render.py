@@ -225,6 +225,17 @@ def animate_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: 
     return Path(path)
 
 
+def undrawn_peak_note(values: np.ndarray, drawn: np.ndarray, rtol: float = 0.01) -> str | None:
+    """A note when the field's maximum lies at a node the surface does not draw (a P2 mid-side
+    node or an interior node), so the colour bar stops below the maximum a title states; None
+    when the drawn nodes reach it within ``rtol``. Both arrays in the colour bar's units."""
+    top, seen = float(np.max(values)), float(np.max(drawn))
+    if top <= 0 or seen >= (1.0 - rtol) * top:
+        return None
+    return (f"colours: the drawn (surface corner) nodes, up to {seen:.3g}; the maximum "
+            f"{top:.3g} lies at a node not drawn (mid-side or interior)")
+
+
 def render_scalar(surface: Surface, values: np.ndarray, path, title: str, camera: dict,
                   label: str = "von Mises stress, MPa", scale: float = 1e-6,
                   displacement: np.ndarray | None = None, window_size=WINDOW_SIZE) -> Path:
@@ -238,6 +249,7 @@ def render_scalar(surface: Surface, values: np.ndarray, path, title: str, camera
         Static displacement, m; drawn exaggerated over a ghost when given.
     """
     v = np.asarray(values, float)[surface.node_ids] * scale
+    note = undrawn_peak_note(np.asarray(values, float) * scale, v)
     pl = _plotter(window_size)
     try:
         pts = surface.points
@@ -254,6 +266,8 @@ def render_scalar(surface: Surface, values: np.ndarray, path, title: str, camera
                                      "position_x": 0.87, "position_y": 0.15, "height": 0.7,
                                      "width": 0.06, "fmt": "%.3g"})
         pl.add_text(title, position="upper_edge", font_size=14, color="black")
+        if note:
+            pl.add_text(note, position="lower_left", font_size=9, color="#555555")
         _add_triad(pl)
         _place_camera(pl, camera)
         with atomic_path(path) as tmp:
