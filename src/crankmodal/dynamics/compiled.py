@@ -522,6 +522,12 @@ class CompiledSystem:
         self._diag = np.zeros((nc, len(DIAG)))
         self._kin = np.zeros(len(DIAG))
         self._zeros = np.zeros(self.n)
+        # for solve's per-joint diagnostics
+        self._cl_frames = [(int(a[0]), int(a[1])) for a in
+                           self._table("cl_int").reshape(-1, 4)]
+        self._fcol = [int(i) for i in self._table("fcol")]
+        f = FLOAT_TABLES.index("floc")
+        self._floc = self.F[self.fo[f]:self.fo[f + 1]].reshape(-1, 3).copy()
         self._scratch = (np.empty(self.m), np.empty(self.m), np.empty((self.m, self.n)),
                          np.zeros(5))
         nb = int(np.count_nonzero(mdiag == 0.0))
@@ -598,15 +604,13 @@ class CompiledSystem:
         return self.I[self.io[k]:self.io[k + 1]]
 
     def _frames_of(self, j):
-        cl = self._table("cl_int").reshape(-1, 4)
-        return int(cl[j, 0]), int(cl[j, 1])
+        return self._cl_frames[j]
 
     def _jac(self, k, q):
-        i = int(self._table("fcol")[k])
+        i = self._fcol[k]
         if i < 0:
             return np.zeros((3, 0))
-        f = FLOAT_TABLES.index("floc")
-        floc = self.F[self.fo[f]:self.fo[f + 1]].reshape(-1, 3)
+        floc = self._floc
         th = q[i + 2]
         c, s = np.cos(th), np.sin(th)
         ax = c * floc[k, 0] - s * floc[k, 1]
