@@ -401,3 +401,29 @@ def test_exudyn_joints_on_the_interface_markers_give_the_fe_pinned_pinned_bar(re
     assert f[0] < 1e-3 * fe[1] and fe[0] < 1e-3 * fe[1]  # rotation about the pin line
     assert np.all(f[1:6] >= fe[1:6] * (1 - 1e-9))
     assert np.allclose(f[1:5], fe[1:5], rtol=1e-4, atol=0)
+
+
+def test_exudyn_fem_interface_file_round_trip_and_stress_mode_layout(reduced, tmp_path):
+    """What an Exudyn user loads: fem.SaveToFile / FEMinterface.LoadFromFile keep the mesh, the
+    elastic modes and ω², and the stress modes sit in Exudyn's post-processing layout (columns
+    6a … 6a+5 = xx yy zz yz xz xy of elastic mode a)."""
+    exu = pytest.importorskip("exudyn")
+    from exudyn.FEM import FEMinterface
+
+    _, model, body, _ = reduced
+    assert body.stress_modes is not None
+    fem = export.exudyn_fem_interface(body, model)
+    fem.SaveToFile(str(tmp_path / "bar_fem"))
+    back = FEMinterface()
+    back.LoadFromFile(str(tmp_path / "bar_fem"))
+    assert np.array_equal(back.GetNodePositionsAsArray(), body.mesh_points)
+    assert np.array_equal(back.elements[0]["Tet10"], body.mesh_cells)
+    S = np.asarray(body.mode_shapes[:, :, 6:], float).reshape(-1, body.n_modes - 6)
+    assert np.array_equal(back.modeBasis["matrix"], S)
+    assert np.allclose(np.sqrt(back.eigenValues) / (2 * np.pi), body.elastic_frequencies_hz,
+                       rtol=1e-12)
+    assert (back.GetMassMatrix() != model.M).nnz == 0
+    P = back.postProcessingModes["matrix"]
+    assert back.postProcessingModes["outputVariableType"] == exu.OutputVariableType.StressLocal
+    for a in (0, 5):
+        assert np.array_equal(P[:, 6 * a:6 * a + 6], body.stress_modes[:, :, 6 + a])
