@@ -227,7 +227,8 @@ def flexible_body(model, cb, ortho, name: str = "body", stress_modes=None,
     W = ortho.W
     n = W.shape[1]
     m = len(cb.interfaces)
-    shapes = cb.V @ W[:, ~ortho.rigid]
+    full = cb.V @ W if mode_shapes else None  # every mode on the mesh, once
+    shapes = full[:, ~ortho.rigid] if mode_shapes else cb.V @ W[:, ~ortho.rigid]
     Ms = model.M[0::3, 0::3]
     inv = inertia_invariants(model.points, Ms, shapes)
     axes = np.array([i.axis if i.axis is not None else np.full(3, np.nan) for i in cb.interfaces])
@@ -250,7 +251,7 @@ def flexible_body(model, cb, ortho, name: str = "body", stress_modes=None,
         mesh_points=np.asarray(model.points, float) if mode_shapes else None,
         mesh_cells=np.asarray(model.cells) if mode_shapes else None,
         mesh_cell_type=("tetra10" if model.order == 2 else "tetra") if mode_shapes else None,
-        mode_shapes=((cb.V @ W).reshape(len(model.points), 3, n).astype(shape_dtype)
+        mode_shapes=(full.reshape(len(model.points), 3, n).astype(shape_dtype)
                      if mode_shapes else None),
         interface_nodes=[a for a, _ in areas] if mode_shapes else None,
         interface_weights=[w for _, w in areas] if mode_shapes else None,
