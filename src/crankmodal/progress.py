@@ -54,3 +54,30 @@ def bar(total=None, desc: str = "", unit: str = "it", **kwargs):
     kwargs.setdefault("dynamic_ncols", True)
     return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, disable=not enabled(),
                 **kwargs)
+
+
+class PhaseTimings(dict):
+    """A ``{phase_s: seconds}`` timings dict that also advances a progress bar, one step per
+    phase recorded (the phase's name shown): long multi-phase work (a Craig–Bampton reduction)
+    shows where it is without changing how it books its timings."""
+
+    def __init__(self, desc: str, phases: int, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._bar = bar(total=phases, desc=desc, unit="phase")
+
+    def __setitem__(self, key, value):
+        super().__setitem__(key, value)
+        if self._bar is not None:
+            self._bar.set_postfix_str(str(key).removesuffix("_s"), refresh=False)
+            self._bar.update(1)
+            if self._bar.n >= (self._bar.total or 0):
+                self.close()
+
+    def close(self) -> None:
+        """Remove the bar (a no-op once closed)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def __reduce__(self):  # pickled or copied as the plain dict it books
+        return (dict, (dict(self),))

@@ -102,9 +102,18 @@ def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
     path = flexbody_cache_dir() / f"{machine}_{part}_{key}.npz"
     if path.is_file():
         return path
+    import time
+
+    from ..progress import PhaseTimings
+
+    steps = PhaseTimings(f"{where}: reducing the {part}", 4)
+    t0 = time.perf_counter()
     prt, _ = make_part(gp)
+    steps["part_s"] = time.perf_counter() - t0
     mat = make_material(mp)
+    t0 = time.perf_counter()
     model = assemble(prt, mat)
+    steps["assembly_s"] = time.perf_counter() - t0
     if part == "crankshaft":
         n_pins = sum(1 for n in prt.regions if n.startswith("crankpin"))
         specs = crank_interface_specs(prt.regions, -(-n_rods // max(n_pins, 1)))
@@ -112,11 +121,15 @@ def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
         specs = [{"region": n, "kind": "distributing", "segments": 1}
                  for n in ("big_end_bore", "small_end_bore")]
     itf = make_interfaces(prt, interface_specs(prt, {"interfaces": specs, "coupling": "distributing"}))
+    t0 = time.perf_counter()
     body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"], mesh=prt.mesh,
                           name=prt.name, info={"part": prt.name, "material": mat.name,
                                                "machine": machine})
+    steps["reduction_s"] = time.perf_counter() - t0
     path.parent.mkdir(parents=True, exist_ok=True)
     save_flexbody(path, body)  # atomic
+    steps["write_s"] = 0.0
+    steps.close()
     return path
 
 

@@ -331,9 +331,13 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
         raise NumericalError("modal: the Lanczos start vector is zero or not finite")
     theta = Y = res = None
     steps = 0
+    from ..progress import bar
+
+    pbar = bar(total=max_steps, desc="modal: Lanczos", unit="step")
     for j in range(max_steps):
         w = np.array(apply(mq(j)), float)  # own copy: updated in place below
         steps += 1
+        pbar.update(1)
         Mw = np.array(M @ w, float)
         alpha[j] = float(Q[:, j] @ Mw)
         # the three-term recurrence first (two vectors), then full reorthogonalisation, which
@@ -369,6 +373,7 @@ def lanczos(apply, M, v0: np.ndarray, k: int, tol: float, max_steps: int,
     if X is None:
         X = Q[:, :steps] @ Y
         MX = MQ[:, :steps] @ Y if keep_mq else M @ X
+    pbar.close()
     return Lanczos(theta=theta, vectors=X, m_vectors=MX, residuals=res, steps=steps,
                    converged=done)
 

@@ -269,7 +269,9 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
         raise SceneError("reduction.interfaces: at least one interface is needed")
     if (n_modes is None) == (cutoff_hz is None):
         raise SceneError("reduction: give exactly one of n_modes or cutoff_hz")
-    timings: dict = {}
+    from ..progress import PhaseTimings
+
+    timings = PhaseTimings("reduction: Craig–Bampton", 5)
     t0 = time.perf_counter()
     N = model.K.shape[0]
     m6 = 6 * len(interfaces)
@@ -368,6 +370,7 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     if not np.isfinite(res) or res > tol:
         raise NumericalError(f"reduction: fixed-interface eigen-residual {res:.2e} > {tol:.0e}; "
                              f"check the mesh for degenerate elements, or try backend='superlu'")
+    timings.close()
     return CraigBamptonBasis(V=V, K=Kr, M=Mr, n_boundary=m6,
                              fixed_interface_hz=np.sqrt(np.abs(lam)) / (2 * np.pi),
                              interfaces=list(interfaces), n_interior=len(I), support=I[support],

@@ -53,7 +53,11 @@ def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
         With the full-size basis ``cb.V`` (for checks and visualisation).
     """
     cb = craig_bampton(model, interfaces, n_modes=n_modes, cutoff_hz=cutoff_hz, backend=backend)
-    timings = dict(cb.timings)
+    from ..progress import PhaseTimings
+
+    if hasattr(cb.timings, "close"):
+        cb.timings.close()
+    timings = PhaseTimings("reduction: body", 3 if mesh is not None and stress else 2, cb.timings)
     t0 = time.perf_counter()
     Ra = np.vstack([interface_rigid_fields(interfaces), np.zeros((cb.n_fixed_modes, 6))])
     ortho = orthonormalise(cb.K, cb.M, Ra)
@@ -73,5 +77,6 @@ def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
                                "rigid_defect": ortho.rigid_defect},
                          mode_shapes=mesh is not None, shape_dtype=shape_dtype)
     timings["invariants_s"] = time.perf_counter() - t0
-    body.info["timings_s"] = timings
+    timings.close()
+    body.info["timings_s"] = dict(timings)
     return body, cb
