@@ -9,7 +9,8 @@
 # `scenes/slider_crank_dynamics.toml`. Two four-stroke cycles per case; statistics over the
 # second (the first holds a start-up impact: crankmodal releases the journals at the bore centre).
 #
-# Run time about 2.5 min (three runs of 40-50 s); `pytest -m slow tests/test_notebooks.py` runs it.
+# Run time 1-2.5 min (three runs of 13-50 s, with the machine's load); `pytest -m slow
+# tests/test_notebooks.py` runs it.
 # crankmodal: slow-notebook
 
 # %%
