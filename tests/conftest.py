@@ -49,3 +49,16 @@ def run_in_process(*argv) -> tuple[int, str]:
 @pytest.fixture
 def cli():
     return run_cli
+
+
+def peak_hz(t, s) -> float:
+    """Frequency of a signal's largest spectral peak, Hz (Hann window, 64x zero padding,
+    parabolic interpolation of the peak bin)."""
+    import numpy as np
+
+    s = (s - s.mean()) * np.hanning(len(s))
+    nfft = 64 * len(s)
+    a = np.abs(np.fft.rfft(s, nfft))
+    i = int(np.argmax(a[1:])) + 1
+    d = 0.5 * (a[i - 1] - a[i + 1]) / (a[i - 1] - 2 * a[i] + a[i + 1])
+    return (i + d) / (nfft * (t[1] - t[0]))

@@ -6,6 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from conftest import peak_hz
 
 from crankmodal.dynamics.bodies import Ground, RigidBody
 from crankmodal.dynamics.flexible import FlexibleBody, load_flexible_body
@@ -173,16 +174,6 @@ def _pinned_pinned_fe_hz(reduced):
     return float(np.sqrt(lam[j]) / (2 * np.pi))
 
 
-def _peak_hz(t, s):
-    """Frequency of the largest spectral peak (Hann window, 64x zero padding, parabolic)."""
-    s = (s - s.mean()) * np.hanning(len(s))
-    nfft = 64 * len(s)
-    a = np.abs(np.fft.rfft(s, nfft))
-    i = int(np.argmax(a[1:])) + 1
-    d = 0.5 * (a[i - 1] - a[i + 1]) / (a[i - 1] - 2 * a[i] + a[i + 1])
-    return (i + d) / (nfft * (t[1] - t[0]))
-
-
 def test_struck_pinned_pinned_bar_rings_at_the_fe_frequency(reduced):
     """Both end interfaces pinned to ground, at rest, struck (modal velocity of the first
     in-plane bending mode): the centre of mass rings at the full FE pinned–pinned frequency
@@ -201,7 +192,7 @@ def test_struck_pinned_pinned_bar_rings_at_the_fe_frequency(reduced):
     t_end = 20 / f_fe
     t_out = np.linspace(0.0, t_end, 2001)
     integ = _run(sysm, np.zeros(3 + k), qd0, t_end, t_out, 1e-8, 1e-13)
-    f_dyn = _peak_hz(t_out, integ.y[1])
+    f_dyn = peak_hz(t_out, integ.y[1])
     assert np.ptp(integ.y[1]) > 0
     assert abs(f_dyn / f_fe - 1) < 5e-3, (f_dyn, f_fe)
 

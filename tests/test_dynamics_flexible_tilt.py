@@ -7,6 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from conftest import peak_hz
 
 from crankmodal.dynamics.bodies import Ground
 from crankmodal.dynamics.flexible import load_flexible_body
@@ -138,15 +139,6 @@ def _ring(flex, t_end, j, n_out=2001):
     return t_out, integ.y[3 + j]
 
 
-def _peak_hz(t, s):
-    s = (s - s.mean()) * np.hanning(len(s))
-    nfft = 64 * len(s)
-    a = np.abs(np.fft.rfft(s, nfft))
-    i = int(np.argmax(a[1:])) + 1
-    d = 0.5 * (a[i - 1] - a[i + 1]) / (a[i - 1] - 2 * a[i] + a[i + 1])
-    return (i + d) / (nfft * (t[1] - t[0]))
-
-
 def test_shaft_on_two_journals_rings_at_the_fe_frequency_only_with_its_tilts(shaft):
     """Both journals held in the plane, struck in the antisymmetric bending mode (the
     journals move apart in it, so its mean axis turns): with the tilts it rings at the full FE
@@ -159,8 +151,8 @@ def test_shaft_on_two_journals_rings_at_the_fe_frequency_only_with_its_tilts(sha
     j = _antisymmetric_x_mode(flex)
     t, x = _ring(flex, t_end=20 / f_fe, j=j)
     assert np.ptp(x) > 0
-    f_tilt = _peak_hz(t, x)
+    f_tilt = peak_hz(t, x)
     assert abs(f_tilt / f_fe - 1) < 1e-2, (f_tilt, f_fe)
     stiff = load_flexible_body(shaft.path, "shaft", damping_ratio=0.0)
     t, x = _ring(stiff, t_end=20 / f_fe, j=j)
-    assert _peak_hz(t, x) > 1.3 * f_fe
+    assert peak_hz(t, x) > 1.3 * f_fe

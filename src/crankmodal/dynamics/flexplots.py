@@ -8,17 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import pyplot as _plt
-
-
-def _save(plt, fig, path: Path) -> Path:
-    from ..results import savefig_atomic
-
-    fig.tight_layout()
-    try:
-        savefig_atomic(fig, path, dpi=110)
-    finally:
-        plt.close(fig)
-    return path
+from .plots import _save
 
 
 def _last_revolution(hist, sel):
