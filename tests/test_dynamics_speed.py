@@ -101,6 +101,22 @@ def test_a_smooth_run_is_the_same_on_both_paths():
                                    atol=1e-9 * np.max(np.abs(py.energy[k])))
 
 
+def test_a_free_journal_without_constraints_is_compiled_too():
+    # no constraint rows: the reduced system is empty (the journal-in-bearing impact tests of
+    # test_dynamics_contact run this case against closed forms)
+    ground = Ground(frames={"bore": (0.0, 0.0)})
+    journal = RigidBody("journal", 2.0, 1e-3, {"centre": (0.0, 0.0)})
+    joint = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
+                           journal_radius=0.01, law=laws.Hertz(stiffness=1e10),
+                           friction=laws.Coulomb(**FRICTION))
+    sysm = Multibody([journal], [], [joint], gravity=(0.0, -9.81))
+    assert sysm.kernel() is not None
+    y = np.array([1.2e-4, 3e-5, 0.1, 0.3, -0.2, 50.0, 0, 0, 0, 0, 0, 0])
+    py, co = _both(sysm, sysm.rhs, 0.0, y)
+    np.testing.assert_allclose(co, py, rtol=1e-13, atol=1e-9)
+    assert py[3] < 0.0  # pushed back from the wall
+
+
 def test_what_has_no_compiled_form_stays_on_the_python_path():
     ground = Ground(frames={"bore": (0.0, 0.0)})
     journal = RigidBody("journal", 1.0, 1e-3, {"centre": (0.0, 0.0)})

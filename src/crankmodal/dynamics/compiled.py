@@ -555,9 +555,12 @@ class CompiledSystem:
         # place: compiling np.linalg.solve would cost 10 s more at the first run, and NumPy's
         # own wrapper twice the time of this call. A is symmetric, so its transpose is the
         # Fortran-ordered A that gesv overwrites without a copy.
-        _, _, sol, info = _gesv(A.T, rhs, overwrite_a=True, overwrite_b=True)
-        if info > 0:
-            raise np.linalg.LinAlgError("Singular matrix")
+        if rhs.size:
+            _, _, sol, info = _gesv(A.T, rhs, overwrite_a=True, overwrite_b=True)
+            if info > 0:
+                raise np.linalg.LinAlgError("Singular matrix")
+        else:  # no constraints and every coordinate with mass: nothing to solve
+            sol = rhs
         return finish(sol, Q, Cq, cqd, self.I, self.io, self.F, self.fo, qdd, lam, powers)
 
     def rhs(self, t, y, v_impact=None):
