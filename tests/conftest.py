@@ -62,3 +62,18 @@ def peak_hz(t, s) -> float:
     i = int(np.argmax(a[1:])) + 1
     d = 0.5 * (a[i - 1] - a[i + 1]) / (a[i - 1] - 2 * a[i] + a[i + 1])
     return (i + d) / (nfft * (t[1] - t[0]))
+
+
+def part_context(part, material, out_dir):
+    """A StageContext whose earlier stages made ``part`` and ``material`` (for calling one
+    FE stage's ``run`` directly)."""
+    from pathlib import Path
+
+    from crankmodal.runner import StageContext
+    from crankmodal.scene import Scene
+
+    ctx = StageContext(scene=Scene(name="t", base_dir=Path(out_dir)), out_dir=Path(out_dir),
+                       figures=False)
+    ctx.products["geometry"] = part
+    ctx.products["material"] = material
+    return ctx

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import part_context
 
 from crankmodal.fem.assembly import assemble
 from crankmodal.fem.materials import Material
@@ -14,7 +15,6 @@ from crankmodal.reduction import export, stage
 from crankmodal.reduction.interfaces import make_interfaces
 from crankmodal.reduction.io import load_flexbody, save_flexbody
 from crankmodal.reduction.reduce import reduce_body
-from crankmodal.runner import StageContext
 from crankmodal.scene import Scene
 
 STEEL = Material("steel", 2.1e11, 0.3, 7850.0)
@@ -95,14 +95,6 @@ def _interfaces(reduced):
                                   {"region": "end_x1", "kind": "rigid"}])
 
 
-def _ctx(part, tmp_path):
-    ctx = StageContext(scene=Scene(name="t", base_dir=Path(tmp_path)), out_dir=Path(tmp_path),
-                       figures=False)
-    ctx.products["geometry"] = part
-    ctx.products["material"] = STEEL
-    return ctx
-
-
 def test_stage_writes_the_modes_vtu_equal_to_the_npz_shapes(tmp_path):
     """Oracle: the VTU's vectors are the .npz's shapes, and those are M-orthonormal against the
     FE mass matrix assembled afresh for the same part (and the stress modes stay optional)."""
@@ -112,7 +104,7 @@ def test_stage_writes_the_modes_vtu_equal_to_the_npz_shapes(tmp_path):
     p = stage.validate({"coupling": "distributing", "n_modes": 6, "file": "tube.npz",
                         "stress_modes": False, "compare_full": False},
                        Scene(name="t", base_dir=Path(tmp_path)))
-    res = stage.run(p, _ctx(part, tmp_path))
+    res = stage.run(p, part_context(part, STEEL, tmp_path))
     assert Path(res["modes_vtu"]) == tmp_path / "tube_modes.vtu"
     assert "tube_modes.vtu" in res["files"]
     json.dumps(res, default=lambda a: np.asarray(a).tolist())

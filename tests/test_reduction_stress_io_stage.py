@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import part_context
 
 from crankmodal.errors import InputFileError, SceneError
 from crankmodal.fem.assembly import assemble
@@ -16,7 +17,6 @@ from crankmodal.reduction.interfaces import make_interfaces
 from crankmodal.reduction.io import load_flexbody, save_flexbody
 from crankmodal.reduction.reduce import reduce_body
 from crankmodal.reduction.stress_modes import stress_modes, stress_recovery, von_mises
-from crankmodal.runner import StageContext
 from crankmodal.scene import Scene
 
 STEEL = Material("steel", 2.1e11, 0.3, 7850.0)
@@ -97,19 +97,11 @@ def test_npz_round_trip_and_plain_numpy_reading(clamped_bar, tmp_path):
         load_flexbody(tmp_path / "missing.npz")
 
 
-def _ctx(part, tmp_path):
-    ctx = StageContext(scene=Scene(name="t", base_dir=Path(tmp_path)), out_dir=Path(tmp_path),
-                       figures=False)
-    ctx.products["geometry"] = part
-    ctx.products["material"] = STEEL
-    return ctx
-
-
 def test_stage_reduces_a_tube_and_matches_the_full_model(tmp_path):
     part = tube(0.02, 0.04, 0.12, divisions=(2, 16, 6), order=2)
     p = stage.validate({"coupling": "distributing", "n_modes": 16, "n_compare": 4},
                        Scene(name="t", base_dir=Path(tmp_path)))
-    res = stage.run(p, _ctx(part, tmp_path))
+    res = stage.run(p, part_context(part, STEEL, tmp_path))
     assert [i["name"] for i in res["interfaces"]] == ["bore", "outer"]  # cylindrical regions
     assert res["rigid_body_modes"] == 6
     assert np.abs(res["relative_difference"]).max() < 0.005
@@ -132,4 +124,4 @@ def test_stage_validation_names_the_key(tmp_path):
         stage.validate({"bogus": 1}, sc)
     p = stage.validate({"interfaces": [{"region": "nope"}]}, sc)
     with pytest.raises(SceneError, match=r"interfaces\[0\].region: no region 'nope'"):
-        stage.run(p, _ctx(bar(0.2, 0.02, 0.02, (4, 1, 1), order=1), tmp_path))
+        stage.run(p, part_context(bar(0.2, 0.02, 0.02, (4, 1, 1), order=1), STEEL, tmp_path))
