@@ -4,10 +4,12 @@ Each notebook is a jupytext pair: ``NAME.ipynb`` (opens in Jupyter as it is) and
 (percent format). The tests check that every pair exists, is a valid nbformat-4 notebook and
 holds the same cells, and execute the notebooks with nbclient on a Python kernel: the quick
 ones (each well under a minute, small settings) in the default run, the ones marked
-``# crankmodal: slow-notebook`` (minutes of simulation) with ``-m slow``. Every notebook asserts
+``# crankmodal: slow-notebook`` (minutes of simulation) with ``-m slow``; one marked
+``# crankmodal: needs <module>`` (an export into another code) only where that module imports. Every notebook asserts
 its numbers against closed forms or checks, so a run that finishes is a run whose checks held.
 """
 
+import re
 from pathlib import Path
 
 import pytest
@@ -15,6 +17,9 @@ import pytest
 NB_DIR = Path(__file__).resolve().parent.parent / "notebooks"
 SOURCES = sorted(NB_DIR.glob("*.py"))
 SLOW_MARK = "# crankmodal: slow-notebook"
+#: a notebook showing crankmodal's export into another code says so; it runs only where that
+#: code is installed (e.g. "# crankmodal: needs exudyn")
+NEEDS = re.compile(r"^# crankmodal: needs (\w+)", re.MULTILINE)
 
 
 def _is_slow(path: Path) -> bool:
@@ -46,6 +51,8 @@ def _execute(source: Path, tmp_path: Path):
     jupytext = pytest.importorskip("jupytext")
     nbclient = pytest.importorskip("nbclient")
     pytest.importorskip("ipykernel")
+    for module in NEEDS.findall(source.read_text(encoding="utf-8")):
+        pytest.importorskip(module, reason=f"{source.name} needs {module}")
     nb = jupytext.read(source)
     client = nbclient.NotebookClient(nb, timeout=1800, kernel_name="python3",
                                      resources={"metadata": {"path": str(tmp_path)}})
