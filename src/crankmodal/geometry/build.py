@@ -75,19 +75,30 @@ def build_part(params: CrankshaftParams | ConrodParams, fidelity: str, settings:
         check_conrod(params)
         from .conrod import build_conrod as builder
         kind = "rod"
+    import time
+
+    from ..progress import PhaseTimings
+
     described = {**params.to_dict(), "fidelity": fidelity, **settings.to_dict()}
+    phases = PhaseTimings(f"geometry: {kind} ({fidelity})", 3)
+    t0 = time.perf_counter()
     with gmsh_session(f"{kind} ({fidelity})", described) as gmsh:
         volumes, specs, detail = builder(gmsh, params, fidelity)
         cad = cad_mass_properties(gmsh, volumes)
+        phases["cad_s"] = time.perf_counter() - t0
         if step_file is not None:
             gmsh.option.setString("Geometry.OCCTargetUnit", "M")  # the STEP file says metres
             with quiet_stdout():  # OpenCASCADE's STEP writer prints its statistics
                 gmsh.write(str(step_file))
         refined = sorted(set(detail_faces(gmsh, detail["radius"])) | set(detail["faces"]))
+        t0 = time.perf_counter()
         mesh, regions, stats = mesh_tagged(gmsh, volumes, specs, settings, refined)
+        phases["mesh_s"] = time.perf_counter() - t0
     try:
         stats["mass_check"] = compare(cad, mesh_mass_properties(mesh.points, mesh.cells[0].data))
+        phases["mass_check_s"] = 0.0
     except ValueError as exc:
+        phases.close()
         from ..errors import GeometryError
 
         raise GeometryError(f"{kind} ({fidelity}): {exc}; parameters: {described}") from None
