@@ -140,10 +140,11 @@ def solve_static(model: FEModel, mesh, load: np.ndarray, supports: list[Support]
     SceneError
         If the supports leave a mechanism (names how many rigid-body modes remain).
     """
+    from ..progress import PhaseTimings
     from .modal import expected_rigid_modes
     from .solvers import factorize
 
-    timings = {}
+    timings = PhaseTimings("static", 3)
     t0 = time.perf_counter()
     T = reduction(model.points, model.used, list(supports))
     free_rigid = expected_rigid_modes(model, T)
@@ -175,4 +176,4 @@ def solve_static(model: FEModel, mesh, load: np.ndarray, supports: list[Support]
                         max_displacement=float(np.linalg.norm(disp, axis=1).max()),
                         safety_factor_yield=sf(mat.yield_strength),
                         safety_factor_ultimate=sf(mat.ultimate_strength),
-                        reaction=reaction, n_dofs=int(K.shape[0]), timings=timings)
+                        reaction=reaction, n_dofs=int(K.shape[0]), timings=dict(timings))
