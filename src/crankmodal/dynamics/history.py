@@ -238,10 +238,11 @@ def record(mech, sysm, integ) -> History:
 
 
 def _solve_at(sysm, integ, t, q, qd) -> dict:
-    """``sysm.solve`` at one state, with each clearance joint's contact in progress."""
-    for cj, ons in zip(sysm.clearances, integ.onsets):
-        cj.v_impact = _impact_velocity(ons, t, cj)
-    return sysm.solve(t, q, qd)
+    """``sysm.solve`` at one state, with each clearance joint's contact in progress (the
+    impact velocities passed in, as the integrator does; no state left in the joints)."""
+    v = np.array([_impact_velocity(ons, t, cj)
+                  for cj, ons in zip(sysm.clearances, integ.onsets)], float)
+    return sysm.solve(t, q, qd, v_impact=v if len(v) else None)
 
 
 def _record_peaks(mech, sysm, integ, pins) -> dict:
