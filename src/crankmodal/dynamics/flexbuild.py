@@ -137,14 +137,28 @@ def _in_plane_angle(v) -> float:
     return float(np.arctan2(v[1], v[0]))
 
 
-def crank_body(path, spec: dict, row_z, crank_radius: float | None, name: str = "crank"):
+def read(source):
+    """``(reduced body, path)`` of a flexbody file path, or of a body read already (so that
+    several planar bodies are made from one reading)."""
+    from ..reduction.io import load_flexbody
+
+    if isinstance(source, (str, Path)):
+        return load_flexbody(source), Path(source)
+    return source, Path(source.info.get("file", source.name))
+
+
+def _centres(fb) -> dict:
+    return {n: np.asarray(c, float) for n, c in zip(fb.interface_names, fb.interface_centres)}
+
+
+def crank_body(source, spec: dict, row_z, crank_radius: float | None, name: str = "crank"):
     """A planar flexible crank from a flexbody file, frames named for a crank train.
 
     Parameters
     ----------
-    path : str or Path
+    source : str, Path or reduced body
         ``crankmodal-flexbody`` file of a crankshaft (interfaces ``main_journal_*``,
-        ``crankpin_*`` bands, optionally ``flywheel_end_face``).
+        ``crankpin_*`` bands, optionally ``flywheel_end_face``), or that body read already.
     spec : dict
         ``n_modes`` / ``cutoff_hz`` / ``damping_ratio``.
     row_z : sequence of float
@@ -158,10 +172,10 @@ def crank_body(path, spec: dict, row_z, crank_radius: float | None, name: str = 
     roles : dict
         ``mains`` (frame names), ``pins`` (one per rod), ``drive``.
     """
-    from .flexible import load_flexible_body
+    from .flexible import planar_body
 
-    probe = load_flexible_body(path, name, n_modes=0)
-    centres = {n: np.asarray(c, float) for n, c in probe.info["interface_centres"].items()}
+    fb, path = read(source)
+    centres = _centres(fb)
     mains = sorted(n for n in centres if n.startswith("main_journal"))
     bands = sorted(n for n in centres if n.startswith("crankpin"))
     if not mains or not bands:
@@ -180,10 +194,9 @@ def crank_body(path, spec: dict, row_z, crank_radius: float | None, name: str = 
         dz = [abs(centres[n][2] - pin_mid[2] - z) for n in bands]
         pins.append(bands[int(np.argmin(dz))])
     drive = "flywheel_end_face" if "flywheel_end_face" in centres else mains[0]
-    body = load_flexible_body(path, name, n_modes=spec.get("n_modes"),
-                              cutoff_hz=spec.get("cutoff_hz"),
-                              damping_ratio=spec["damping_ratio"], tilt=len(mains) > 1,
-                              orientation=_in_plane_angle(arm))
+    body = planar_body(fb, name, n_modes=spec.get("n_modes"), cutoff_hz=spec.get("cutoff_hz"),
+                       damping_ratio=spec["damping_ratio"], tilt=len(mains) > 1,
+                       orientation=_in_plane_angle(arm), path=path)
     roles = {"mains": [], "pins": [], "drive": "drive"}
     for j, n in enumerate(mains, start=1):
         body.alias(f"main_{j}", n)
@@ -197,25 +210,28 @@ def crank_body(path, spec: dict, row_z, crank_radius: float | None, name: str = 
     return body, roles
 
 
-def rod_body(path, spec: dict, rod_length: float | None, name: str, z: float = 0.0):
-    """A planar flexible rod from a flexbody file with ``big_end_bore`` and ``small_end_bore``
-    interfaces: frames ``big`` and ``small``, body x axis from the big to the small end; its
-    length checked against the mechanism's ``rod_length`` (m, ±1 %)."""
-    from .flexible import load_flexible_body
+def rod_body(source, spec: dict, rod_length: float | None, name: str, z: float = 0.0):
+    """A planar flexible rod from a flexbody file (or that body read already, ``source``) with
+    ``big_end_bore`` and ``small_end_bore`` interfaces: frames ``big`` and ``small``, body x axis
+    from the big to the small end; its length checked against the mechanism's ``rod_length``
+    (m, ±1 %)."""
+    from .flexible import planar_body
 
-    probe = load_flexible_body(path, name, n_modes=0,
-                               interfaces=("big_end_bore", "small_end_bore"))
-    c = probe.info["interface_centres"]
-    d = np.asarray(c["small_end_bore"], float)[:2] - np.asarray(c["big_end_bore"], float)[:2]
+    fb, path = read(source)
+    c = _centres(fb)
+    for bore in ("big_end_bore", "small_end_bore"):
+        if bore not in c:
+            raise SceneError(f"dynamics.flexible.rods.file: {path}: no interface {bore!r}; "
+                             f"interfaces: {', '.join(c) or 'none'}")
+    d = c["small_end_bore"][:2] - c["big_end_bore"][:2]
     length = float(np.hypot(*d))
     if rod_length is not None and abs(length / rod_length - 1) > GEOMETRY_TOLERANCE:
         raise SceneError(f"dynamics.flexible.rods.file: {path}: its bores are {length:.5g} m "
                          f"apart, the mechanism's rod length is {rod_length:.5g} m "
                          f"(tolerance {GEOMETRY_TOLERANCE:.0%})")
-    body = load_flexible_body(path, name, n_modes=spec.get("n_modes"),
-                              cutoff_hz=spec.get("cutoff_hz"),
-                              damping_ratio=spec["damping_ratio"], z=z,
-                              orientation=_in_plane_angle(d))
+    body = planar_body(fb, name, n_modes=spec.get("n_modes"), cutoff_hz=spec.get("cutoff_hz"),
+                       damping_ratio=spec["damping_ratio"], z=z, orientation=_in_plane_angle(d),
+                       path=path)
     body.alias("big", "big_end_bore")
     body.alias("small", "small_end_bore")
     return body
@@ -225,30 +241,17 @@ def rigid_twin(body):
     """The rigid body with a flexible body's mass, inertia and frames (its modes frozen).
 
     A crank with tilts (held at two or more journals) stays a :class:`~.flexible.FlexibleBody`
-    with its tilts and no elastic mode, so that each journal's force is still defined; any
-    other body becomes a :class:`~.bodies.RigidBody` (the fast path).
+    with its tilts and no elastic mode (:meth:`~.flexible.FlexibleBody.frozen`), so that each
+    journal's force is still defined; any other body becomes a :class:`~.bodies.RigidBody`
+    (the fast path).
     """
     from .bodies import RigidBody
-    from .flexible import FlexibleBody
 
     if body.n_tilt:
-        k = body.n_modes
-        keep = np.r_[k - body.n_tilt:k]
-        frames = {n: (s0, D[:, keep], rz[keep]) for n, (s0, D, rz) in body.frames.items()}
-        twin = FlexibleBody.__new__(FlexibleBody)
-        twin.__dict__.update({a: v for a, v in body.__dict__.items()
-                              if a not in ("_stacked", "_geo", "_bias")})  # no stale caches
-        twin.frequencies_hz = body.frequencies_hz[keep]
-        twin.n_modes, twin.n_elastic, twin.ndof = body.n_tilt, 0, 3 + body.n_tilt
-        for a in ("zeta", "K", "C", "b", "c"):
-            setattr(twin, a, getattr(body, a)[keep])
-        twin.G, twin.S = body.G[np.ix_(keep, keep)], body.S[np.ix_(keep, keep)]
-        twin.frames = frames
-        twin.info = dict(body.info, rigid_twin=True)
-        return twin
+        return body.frozen()
     frames = {n: (float(s0[0]), float(s0[1])) for n, (s0, _, _) in body.frames.items()}
     return RigidBody(body.name, body.mass, body.j0, frames, z=body.z)
 
 
-__all__ = ["crank_body", "crank_interface_specs", "flexbody_cache_dir", "reduced_part",
+__all__ = ["crank_body", "crank_interface_specs", "flexbody_cache_dir", "read", "reduced_part",
            "rigid_twin", "rod_body"]

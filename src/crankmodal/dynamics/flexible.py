@@ -80,7 +80,7 @@ class FlexibleBody:
 
     def __init__(self, name, mass, j0, centre, frequencies_hz, G, b, S, interfaces,
                  damping_ratio=DEFAULT_DAMPING, z=0.0, info=None, c=None, n_tilt=0,
-                 orientation=0.0):
+                 orientation=0.0, source=None):
         self.name = name
         self.mass = float(mass)
         self.j0 = float(j0)
@@ -111,18 +111,33 @@ class FlexibleBody:
                                mp[5].copy())
         self.z = float(z)
         self.info = dict(info or {})
+        self.source = source  # the reduced body it was made from (stress modes, mesh), or None
 
     def alias(self, name: str, frame: str) -> None:
         """Name interface ``frame`` also ``name`` (a mechanism's frame names: ``main``, ``pin``…)."""
         self.frames[name] = self.frames[frame]
 
+    def frozen(self) -> FlexibleBody:
+        """The same body with its elastic modes frozen: only the tilts (if any) stay as
+        coordinates (a rigid crank on its journals, each journal's force still defined)."""
+        import copy
+
+        keep = np.arange(self.n_elastic, self.n_modes)
+        twin = copy.copy(self)
+        for cache in ("_stacked", "_geo", "_bias"):
+            twin.__dict__.pop(cache, None)
+        twin.frequencies_hz = self.frequencies_hz[keep]
+        twin.n_modes, twin.n_elastic, twin.ndof = len(keep), 0, 3 + len(keep)
+        for a in ("zeta", "K", "C", "b", "c"):
+            setattr(twin, a, getattr(self, a)[keep])
+        twin.G, twin.S = self.G[np.ix_(keep, keep)], self.S[np.ix_(keep, keep)]
+        twin.frames = {n: (s0, D[:, keep], rz[keep]) for n, (s0, D, rz) in self.frames.items()}
+        twin.info = dict(self.info, rigid_twin=True)
+        return twin
+
     def local(self, frame: str) -> tuple[np.ndarray, float]:
         """Undeformed position of an interface in the body frame (m) and its angle offset (0)."""
         return np.array(self.frames[frame][0], float), 0.0
-
-    def elastic(self, q: np.ndarray) -> np.ndarray:
-        """The elastic modal coordinates of ``q`` (without the tilt coordinates), m kg^½."""
-        return q[3:3 + self.n_elastic]
 
     # ----------------------------------------------------------------- inertia
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
@@ -247,16 +262,34 @@ def _fail(path, text, cls=SceneError):
     raise cls(f"{path}: {text}")
 
 
-def load_flexible_body(path, name: str, n_modes: int | None = None,
+def load_flexible_body(path, name: str, **kwargs) -> FlexibleBody:
+    """Read a ``crankmodal-flexbody`` .npz as a planar :class:`FlexibleBody`
+    (:func:`planar_body`'s keywords).
+
+    Raises
+    ------
+    InputFileError
+        Not a readable crankmodal-flexbody file of version 1.
+    SceneError
+        As :func:`planar_body`.
+    """
+    from ..reduction.io import load_flexbody
+
+    return planar_body(load_flexbody(path), name, path=path, **kwargs)
+
+
+def planar_body(fb, name: str, n_modes: int | None = None,
                        cutoff_hz: float | None = None,
                        damping_ratio=DEFAULT_DAMPING, interfaces=None,
                        min_in_plane: float = MIN_IN_PLANE, z: float = 0.0, tilt: bool = False,
-                       orientation: float = 0.0) -> FlexibleBody:
-    """Read a ``crankmodal-flexbody`` .npz as a planar :class:`FlexibleBody`.
+                       orientation: float = 0.0, path=None) -> FlexibleBody:
+    """A planar :class:`FlexibleBody` from a reduced body (:func:`crankmodal.reduction.io.load_flexbody`).
+
+    Several planar bodies (four rods) can be made from one reading of the file.
 
     Parameters
     ----------
-    path : str or Path
+    fb : crankmodal.reduction.flexbody.FlexibleBody
     name : str
         Body name.
     n_modes : int, optional
@@ -279,18 +312,15 @@ def load_flexible_body(path, name: str, n_modes: int | None = None,
     orientation : float
         Angle of the body frame's x axis from the part's x axis, rad (e.g. the crank's pin
         direction, so that the frame angle is the crank angle).
+    path : str or Path, optional
+        The file it was read from (error messages and provenance).
 
     Raises
     ------
-    InputFileError
-        Not a readable crankmodal-flexbody file of version 1.
     SceneError
         More modes than stored, both or a bad selection, negative damping, a missing interface.
     """
-    from ..reduction.io import load_flexbody
-
-    path = Path(path)
-    fb = load_flexbody(path)  # InputFileError: missing, unreadable, other format or version
+    path = Path(path) if path is not None else Path(fb.name)
     el = ~np.asarray(fb.rigid, bool)
     f_el = fb.frequencies_hz[el]
     inv = fb.invariants
@@ -360,6 +390,7 @@ def load_flexible_body(path, name: str, n_modes: int | None = None,
         centre=fb.centre_of_mass, frequencies_hz=freq, G=G, b=b, S=S, c=c,
         interfaces={n: (centres[i], imap[i]) for i, n in enumerate(names)},
         damping_ratio=zeta, z=z, n_tilt=n_tilt, orientation=orientation,
+        source=fb,
         info={"file": str(path), "part": fb.name, "left_out": left,
               "mode_columns": cols.tolist(),
               "interface_centres": {n: centres[i].tolist() for i, n in enumerate(names)}})
@@ -408,4 +439,4 @@ def tilt_terms(G, b, S, c, imap, I8, inertia, com, centres):
     return G2, b2, S2, c2, im2
 
 
-__all__ = ["DEFAULT_DAMPING", "FlexibleBody", "load_flexible_body", "tilt_terms"]
+__all__ = ["DEFAULT_DAMPING", "FlexibleBody", "load_flexible_body", "planar_body", "tilt_terms"]

@@ -8,17 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import pyplot as _plt
-from .plots import _save
-
-
-def _last_revolution(hist, sel):
-    """Sample mask of the window's last revolution (or the whole window if shorter)."""
-    idx = np.flatnonzero(sel)
-    ang = np.unwrap(hist.crank_angle[idx])
-    turn = np.abs(ang - ang[-1]) <= 2 * np.pi + 1e-9
-    m = np.zeros_like(sel)
-    m[idx[turn]] = True
-    return m
+from .plots import _save, last_revolutions
 
 
 def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
@@ -30,8 +20,8 @@ def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
     joints = mech.main_joints if len(mech.main_joints) > 1 else []
     n = 2 + len(joints)
     fig, ax = plt.subplots(n, 1, figsize=(9, 2.6 * n))
-    last = _last_revolution(hist, sel)
-    ang = np.unwrap(hist.crank_angle[last])
+    last = last_revolutions(hist, 1.0) & sel
+    ang = hist.crank_angle[last]  # a coordinate of the run: continuous, no wrap
     deg = np.rad2deg(np.abs(ang - ang[0]))  # turned since the last revolution began
     series = [("main bearing (sum)", hist.main_bearing_force,
                None if rigid is None else rigid.main_bearing_force)]

@@ -52,7 +52,7 @@ def make_bodies(p, mechanism_params=None) -> dict | None:
     Returns ``{"crank": (body, roles) or None, "rods": [body per cylinder] or None,
     "files": {name: path}}``.
     """
-    from .flexbuild import crank_body, rod_body
+    from .flexbuild import crank_body, read, rod_body
 
     flex = p["flexible"]
     if flex["crank"] is None and flex["rods"] is None:
@@ -71,7 +71,9 @@ def make_bodies(p, mechanism_params=None) -> dict | None:
         key = "rods"
         if flex["rods"] is not None:
             path = _file(flex["rods"], machine, "rod", 1, "rods")
-            out["rods"] = [rod_body(path, flex["rods"], L, f"rod_{i}", z=z)
+            rod = read(path)[0]  # one reading, a planar body per cylinder
+            rod.info["file"] = str(path)
+            out["rods"] = [rod_body(rod, flex["rods"], L, f"rod_{i}", z=z)
                            for i, (L, z) in enumerate(zip(lengths, rows), start=1)]
             out["files"]["rods"] = str(path)
     except (SceneError, InputFileError) as exc:
@@ -127,9 +129,8 @@ def interface_deflections(body, modal) -> dict:
     """Largest elastic in-plane displacement of each interface in the body frame, m."""
     k = body.n_elastic
     out = {}
-    for name, (_, D, _) in body.frames.items():
-        if name in ("main", "drive", "big", "small") or name.startswith(("main_", "pin_")):
-            continue  # aliases of an interface listed under its own name
+    for name in body.info["interface_centres"]:  # the file's interfaces, not their aliases
+        D = body.frames[name][1]
         u = modal[:, :k] @ D[:, :k].T
         out[name] = float(np.hypot(u[:, 0], u[:, 1]).max())
     return out
@@ -145,7 +146,7 @@ def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict 
     from ..reduction.io import load_flexbody
     from ..reduction.stress_modes import von_mises
 
-    fb = load_flexbody(body.info["file"])
+    fb = body.source if body.source is not None else load_flexbody(body.info["file"])
     modes = getattr(fb, "stress_modes", None)
     if modes is None or body.n_elastic == 0:
         return None

@@ -215,7 +215,7 @@ def record(mech, sysm, integ) -> History:
                                                 - energy["dissipated_friction"])
     # the force of the crank on the housing: the sum over its main journals
     main = np.zeros((K, 2))
-    for name in getattr(mech, "main_joints", None) or [mech.main_joint]:
+    for name in _main_joints(mech):
         main = main + forces.get(name, 0.0)
     moment = np.zeros((K, 2))
     for name, z in mech.rows_z.items():
@@ -235,6 +235,11 @@ def record(mech, sysm, integ) -> History:
                    peaks=_record_peaks(mech, sysm, integ, pins),
                    modal={b.name: integ.y[sysm.slices[id(b)].start + 3: sysm.slices[id(b)].stop].T
                           .copy() for b in getattr(sysm, "_elastic", ())})
+
+
+def _main_joints(mech) -> list:
+    """The joints between the crank and the housing (one per main journal)."""
+    return getattr(mech, "main_joints", None) or [mech.main_joint]
 
 
 def _solve_at(sysm, integ, t, q, qd) -> dict:
@@ -263,7 +268,7 @@ def _record_peaks(mech, sysm, integ, pins) -> dict:
             ck = s["contacts"][j]
             d["t"][k], d["fn"][k], d["penetration"][k] = t, ck["fn"], ck["delta"]
             f = np.zeros(2)
-            for name in getattr(mech, "main_joints", None) or [mech.main_joint]:
+            for name in _main_joints(mech):
                 if name in rows:
                     f = f + s["lam"][rows[name]]
                 elif name in names:

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NumericalError
-
 
 def _elastic_columns(sysm) -> np.ndarray:
     cols = []
@@ -24,27 +22,6 @@ def _elastic_columns(sysm) -> np.ndarray:
             s = sysm.slices[id(b)].start + 3
             cols.extend(range(s, s + k))
     return np.array(cols, int)
-
-
-def assemble_holding(sysm, t, q, qd, hold, tol=1e-12, max_iter=30):
-    """Positions and velocities on the joints, changing only the coordinates not in ``hold``
-    (least change); the held velocities are kept."""
-    q = np.array(q, float)
-    qd = np.array(qd, float)
-    free = np.setdiff1d(np.arange(sysm.n), hold)
-    for _ in range(max_iter):
-        phi, Cq, nu, _ = sysm.constraint_terms(t, q, np.zeros(sysm.n))
-        if np.max(np.abs(phi), initial=0.0) < tol:
-            break
-        q[free] -= np.linalg.lstsq(Cq[:, free], phi, rcond=None)[0]
-    else:
-        raise NumericalError("dynamics: the mechanism cannot be assembled with its bodies "
-                             "deformed (quasi-static start)")
-    _, Cq, nu, _ = sysm.constraint_terms(t, q, np.zeros(sysm.n))
-    if sysm.m:
-        r = Cq @ qd - nu
-        qd[free] -= np.linalg.lstsq(Cq[:, free], r, rcond=None)[0]
-    return q, qd
 
 
 def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
@@ -73,7 +50,7 @@ def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
     def residual(xi):
         qq = np.array(q, float)
         qq[cols] = xi
-        qq, qqd = assemble_holding(sysm, t, qq, qd, cols)
+        qq, qqd = sysm.assemble(t, qq, qd, hold=cols)
         return sysm.solve(t, qq, qqd)["qdd"][cols] / w2, qq, qqd  # the static error in ξ
 
     xi = np.array(q[cols], float)
@@ -94,4 +71,4 @@ def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
     return qq, qqd, {"iterations": it, "residual": float(np.max(np.abs(r)))}
 
 
-__all__ = ["assemble_holding", "quasi_static_start"]
+__all__ = ["quasi_static_start"]

@@ -59,7 +59,6 @@ class Mechanism:
     main_joint: str = "main"
     rows_z: dict = field(default_factory=dict)
     main_joints: list = field(default_factory=list)
-    rods: list = field(default_factory=list)
 
     def __post_init__(self):
         if not self.main_joints:
@@ -80,13 +79,6 @@ def _check_rank(sysm, q, what: str) -> None:
     if rank < sysm.m:
         raise RedundantJoints(f"{what}: {sysm.m - rank} of its {sysm.m} joint equations are "
                               f"redundant (rank {rank})")
-
-
-def _offset(body, frame) -> np.ndarray:
-    """Undeformed position of a body's frame relative to its reference point, m."""
-    if isinstance(body, RigidBody):
-        return body.local(frame)[0]
-    return np.asarray(body.frames[frame][0], float)
 
 
 def _unit(angle):
@@ -204,7 +196,7 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         crank = crank_body
         mains, pin_frames = list(crank_roles["mains"]), list(crank_roles["pins"])
         drive_frame = crank_roles["drive"]
-        s_main = _offset(crank, mains[0])
+        s_main = crank.local(mains[0])[0]  # undeformed, body axes
         q_crank = np.concatenate([-A0 @ s_main, [theta0], np.zeros(crank.ndof - 3)])
     # rigid rotation about the axis at rw: v = rw e_z x (position of the frame origin)
     qd_crank = np.zeros(crank.ndof)
@@ -215,7 +207,6 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     others, loads, pistons, axes, rows_z = [], [], [], [], {}
     angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque, drive_frame)
     others.append(angle_drive)
-    rods = []
     for i, cyl in enumerate(cylinders, start=1):
         u = _unit(cyl.axis_angle)
         nrm = np.array([-u[1], u[0]])
@@ -227,8 +218,8 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
                             {"big": (-a, 0.0), "small": (L - a, 0.0)}, z=cyl.z)
         else:
             rod.z = cyl.z
-        s_big = _offset(rod, "big")
-        L = float(np.hypot(*(_offset(rod, "small") - s_big)))
+        s_big = rod.local("big")[0]
+        L = float(np.hypot(*(rod.local("small")[0] - s_big)))
         piston = RigidBody(f"piston_{i}", cyl.piston_mass, 1.0e-6, {"pin": (0.0, 0.0)}, z=cyl.z)
         h = P @ nrm - cyl.offset
         if abs(h) >= L:
@@ -242,7 +233,6 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         q0 += [G[0], G[1], phi] + [0.0] * (rod.ndof - 3) + [X[0], X[1], cyl.axis_angle]
         qd0 += [0.0] * (rod.ndof + 3)
         bodies += [rod, piston]
-        rods.append(rod)
         pins += [Revolute(f"big_end_{i}", crank, pin_frames[i - 1], rod, "big"),
                  Revolute(f"small_end_{i}", piston, "pin", rod, "small")]
         others.append(Prismatic(f"slider_{i}", piston, "pin", cyl.offset * nrm, u, cyl.axis_angle))
@@ -254,7 +244,7 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     return _finish(kind, bodies, pins, others, loads, clearances or {}, contact_kw or {},
                    np.array(q0), np.array(qd0), crank, drive, gravity, baumgarte,
                    pistons=pistons, axes=axes, revolution_hz=speed_rpm / 60.0, rows_z=rows_z,
-                   main_joint=main_names[0], main_joints=main_names, rods=rods)
+                   main_joint=main_names[0], main_joints=main_names)
 
 
 def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, inertias,

@@ -229,15 +229,14 @@ def run(params: dict, ctx) -> dict:
         joints[cj.name] = j
     res["clearance_joints"] = joints
     # per-revolution statistics: what converges (a single trajectory's peak does not)
-    res["statistics"] = statistics(hist, rev_hz, float(hist.t[sel][0]),
-                                   {cj.name: cj.v_impact_min for cj in mech.system.clearances})
+    v_min = {cj.name: cj.v_impact_min for cj in mech.system.clearances}
+    res["statistics"] = statistics(hist, rev_hz, float(hist.t[sel][0]), v_min)
     if p["ensemble"] > 1:
         from .ensemble import run_ensemble
 
-        res["ensemble"] = run_ensemble(
-            mech, res["statistics"], p["ensemble"], t_end, dt, settings, rev_hz,
-            float(hist.t[sel][0]), {cj.name: cj.v_impact_min for cj in mech.system.clearances},
-            energy_tolerance=tol)
+        res["ensemble"] = run_ensemble(mech, res["statistics"], p["ensemble"], t_end, dt,
+                                       settings, rev_hz, float(hist.t[sel][0]), v_min,
+                                       energy_tolerance=tol)
     if ideal is not None:
         res["ideal"] = {"main_bearing_force_peak_n": float(np.max(np.hypot(
             ideal.main_bearing_force[:, 0], ideal.main_bearing_force[:, 1]))),

@@ -295,14 +295,16 @@ class Multibody:
         return dy
 
     # ----------------------------------------------------------------- initial state
-    def assemble(self, t, q0, qd0, tol=1e-12, max_iter=30):
-        """Consistent positions and velocities close to ``q0``, ``qd0`` (least-change Newton)."""
+    def assemble(self, t, q0, qd0, tol=1e-12, max_iter=30, hold=()):
+        """Consistent positions and velocities close to ``q0``, ``qd0`` (least-change Newton);
+        the coordinates in ``hold`` (indices) keep their positions and velocities."""
         q = np.array(q0, float)
+        free = np.setdiff1d(np.arange(self.n), np.asarray(hold, int))
         for _ in range(max_iter):
             phi, Cq, nu, _ = self.constraint_terms(t, q, np.zeros(self.n))
             if np.max(np.abs(phi), initial=0.0) < tol:
                 break
-            q -= np.linalg.lstsq(Cq, phi, rcond=None)[0]
+            q[free] -= np.linalg.lstsq(Cq[:, free], phi, rcond=None)[0]
         else:
             raise NumericalError(
                 f"dynamics: the mechanism cannot be assembled at t = {t} s (constraint residual "
@@ -312,7 +314,7 @@ class Multibody:
         _, Cq, nu, _ = self.constraint_terms(t, q, np.zeros(self.n))
         qd = np.array(qd0, float)
         if self.m:
-            qd -= np.linalg.lstsq(Cq, Cq @ qd - nu, rcond=None)[0]
+            qd[free] -= np.linalg.lstsq(Cq[:, free], Cq @ qd - nu, rcond=None)[0]
         return q, qd
 
 
