@@ -54,3 +54,51 @@ def warn(text: str, into: list | None = None) -> None:
     warnings.warn(text, ModelWarning, stacklevel=3)
     if into is not None:
         into.append(text)
+
+
+class ParameterError(CrankmodalError, ValueError):
+    """An argument of a core (Python API) function is out of its admissible range.
+
+    The message names the argument (``n_modes: must be >= 1, got 0``). Core functions raise it
+    and know nothing of scenes; a stage that read the value from a scene re-raises it as a
+    :class:`SceneError` naming the scene key (``modal.n_modes: ...``) with :func:`scene_keys`.
+
+    Attributes
+    ----------
+    argument : str
+        The argument's name (a dotted path for nested values, e.g. ``supports[1].fix``).
+    text : str
+        What is wrong, without the name.
+    """
+
+    def __init__(self, argument: str, text: str):
+        self.argument = argument
+        self.text = text
+        super().__init__(f"{argument}: {text}")
+
+
+class scene_keys:
+    """Re-raise :class:`ParameterError` inside the block as :class:`SceneError` under ``prefix``.
+
+    ``keys`` maps an argument name to its scene key when they differ (``{"sigma": "shift"}``);
+    other names are used as they are. Example::
+
+        with scene_keys("modal", {"sigma": "shift"}):
+            modes = solve_modes(model, n_modes=table["n_modes"], sigma=table["shift"])
+    """
+
+    def __init__(self, prefix: str, keys: dict | None = None):
+        self.prefix = prefix
+        self.keys = keys or {}
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if isinstance(exc, ParameterError):
+            head, dot, rest = exc.argument.partition(".")
+            base, bracket, index = head.partition("[")
+            name = self.keys.get(exc.argument) or (self.keys.get(base, base) + bracket + index
+                                                   + dot + rest)
+            raise SceneError(f"{self.prefix}.{name}: {exc.text}") from None
+        return False
