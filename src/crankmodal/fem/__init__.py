@@ -2,7 +2,8 @@
 
 Modules (one concept each): :mod:`materials` (library), :mod:`assembly` (K, M on P1/P2 tets),
 :mod:`solvers` (factorisation backends), :mod:`supports` (constraint elimination),
-:mod:`modal` (shift-invert eigen solution and its checks), :mod:`classify` (mode names),
+:mod:`modal` (the modal solve: :mod:`modes` its result, :mod:`lanczos`,
+:mod:`rigid_modes`, :mod:`modal_checks`, :mod:`dense_eigen`), :mod:`classify` (mode names),
 :mod:`loads` and :mod:`static` (strength), :mod:`convergence` (error against run time),
 :mod:`vtu` (ParaView output). Nothing heavy is imported at package level.
 """
