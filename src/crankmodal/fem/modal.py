@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from ..errors import NumericalError, SceneError
+from ..errors import NumericalError, ParameterError
 from .assembly import NU_ILL_CONDITIONED, FEModel, mass_and_centre, rigid_body_modes
 from .dense_eigen import (
     DENSE_FRACTION,
@@ -87,7 +87,7 @@ def lanczos_pairs(model: FEModel, K, M, Rq: np.ndarray, deflate: bool, k: int,
     n = K.shape[0]
     sigma = default_shift(K, M) if shift is None else float(shift)
     if sigma >= 0:
-        raise SceneError(f"modal.shift: must be < 0, got {sigma}")
+        raise ParameterError("shift", f"must be < 0, got {sigma}")
     t0 = time.perf_counter()
     try:
         fac = factorize_shifted(K, M, sigma, backend, positive_definite=True,
@@ -207,9 +207,20 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
     Returns
     -------
     Modes
+
+    Raises
+    ------
+    ParameterError
+        ``n_modes`` below 1 or above the elastic DOF, ``shift`` not negative, ``eigensolver``
+        unknown or Lanczos asked for nearly every pair (the message names the argument; a stage
+        re-raises it under its scene key with :class:`crankmodal.errors.scene_keys`).
+    NumericalError
+        The pairs fail their checks, or the rigid-body count is not the expected one.
     """
     if n_modes < 1:
-        raise SceneError(f"modal.n_modes: must be >= 1, got {n_modes}")
+        raise ParameterError("n_modes", f"must be >= 1, got {n_modes}")
+    if shift is not None and not float(shift) < 0:
+        raise ParameterError("shift", f"must be < 0, got {float(shift)}")
     timings: dict = {}
     with PeakMemory() as mem:
         t0 = time.perf_counter()
@@ -223,14 +234,15 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         k = n_modes if deflate else n_rigid_expected + n_modes
         n_elastic = n - n_rigid_expected
         if n_modes > n_elastic:
-            raise SceneError(
-                f"modal.n_modes: {n_modes} elastic modes asked, but the part has only "
+            raise ParameterError(
+                "n_modes", f"{n_modes} elastic modes asked, but the part has only "
                 f"{n_elastic} ({n} free DOF less {n_rigid_expected} rigid-body modes); ask for at "
                 f"most {n_elastic}, or refine the mesh")
         timings["reduce_s"] = time.perf_counter() - t0
 
         if eigensolver not in ("auto", "lanczos", "dense"):
-            raise SceneError(f"modal.eigensolver: must be auto, lanczos or dense; got {eigensolver!r}")
+            raise ParameterError("eigensolver",
+                                 f"must be auto, lanczos or dense; got {eigensolver!r}")
         if eigensolver == "dense" or (eigensolver == "auto"
                                       and use_dense(n, n_rigid_expected + n_modes)):
             t0 = time.perf_counter()
@@ -246,9 +258,9 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
             backend_name, eigensolver, n_solves, solve_time = "dense", "dense", 0, 0.0
         else:
             if n_rigid_expected + n_modes >= n - 1:  # only when asked for: auto goes dense
-                raise SceneError(f"modal.eigensolver: Lanczos cannot find "
-                                 f"{n_rigid_expected + n_modes} pairs of {n} DOF; use 'dense' "
-                                 f"or 'auto'")
+                raise ParameterError("eigensolver", f"Lanczos cannot find "
+                                     f"{n_rigid_expected + n_modes} pairs of {n} DOF; use "
+                                     f"'dense' or 'auto'")
             lam, X, K, M, backend_name, n_solves, solve_time = lanczos_pairs(
                 model, K, M, Rq, deflate, k, shift, backend, tol, timings)
             eigensolver = "lanczos"

@@ -47,6 +47,7 @@ def validate(raw: dict, scene) -> dict:
 
 
 def run(p: dict, ctx) -> dict:
+    from ..errors import scene_keys
     from .classify import classify
     from .memory import PeakMemory
     from .modal import solve_modes
@@ -57,8 +58,9 @@ def run(p: dict, ctx) -> dict:
     with PeakMemory() as mem:
         model, t_asm = timed_fe_model(ctx, part, mat)
         sup = select(part, p["supports"], SECTION)
-        modes = solve_modes(model, p["n_modes"], sup, backend=p["backend"],
-                            band=p["band"], tol=p["tol"], eigensolver=p["eigensolver"])
+        with scene_keys(SECTION):  # the core names its arguments: n_modes, eigensolver
+            modes = solve_modes(model, p["n_modes"], sup, backend=p["backend"],
+                                band=p["band"], tol=p["tol"], eigensolver=p["eigensolver"])
         classes = classify(model.points[model.used], modes.shapes.reshape(-1, 3, modes.shapes.shape[1])
                            [model.used].reshape(-1, modes.shapes.shape[1]), axis=p["axis"])
     ctx.products[SECTION] = modes

@@ -119,10 +119,12 @@ def run(p: dict, ctx) -> dict:
         timings = {"assembly_s": t_asm, **body.info["timings_s"]}
         full = None
         if p["compare_full"]:
+            from ..errors import scene_keys
             from ..fem.modal import solve_modes
 
             t0 = time.perf_counter()
-            full = solve_modes(model, p["n_compare"], backend=p["backend"])
+            with scene_keys(SECTION, {"n_modes": "n_compare"}):
+                full = solve_modes(model, p["n_compare"], backend=p["backend"])
             timings["full_modal_s"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     path = save_flexbody(ctx.out_dir / p["file"], body)

@@ -41,14 +41,16 @@ def part_builder(geometry: dict):
 
 def modes_solver(modal: dict, material, n_modes: int):
     """``solve(part) -> Modes`` with the ``[modal]`` supports and backend."""
+    from ..errors import scene_keys
     from ..fem.assembly import assemble
     from ..fem.modal import solve_modes
     from ..fem.supports import select
 
     def solve(part):
         model = assemble(part, material)
-        return solve_modes(model, n_modes, select(part, modal["supports"], "modal"),
-                           backend=modal["backend"], tol=modal["tol"])
+        with scene_keys("modal"):  # as the [modal] stage: its supports, tol, backend
+            return solve_modes(model, n_modes, select(part, modal["supports"], "modal"),
+                               backend=modal["backend"], tol=modal["tol"])
 
     return solve
 
