@@ -13,6 +13,8 @@ import numpy as np
 
 from ..errors import SceneError
 from ..geometry.params import FIDELITIES
+from .keys import SCHEMA as REPORT_SCHEMA
+from .study import MAX_PROBES, SimplificationStudy, evaluate, write_study
 
 
 def part_builder(geometry: dict):
@@ -156,7 +158,6 @@ def run_models_on_engine(geometry, modal, material, s: dict, n_modes: int, out_d
     from ..sweep.driver import LazyClient, run_tasks, run_tasks_in_process
     from ..sweep.store import RecordStore, folder_lock
     from .mac import sample_at
-    from .study import MAX_PROBES, SimplificationStudy
 
     if workers is not None and workers < 1:
         raise CrankmodalError(f"--workers: must be >= 1, got {workers}")
@@ -220,8 +221,6 @@ def run_simplification(params: dict, out_dir, log=None, figures: bool = True, ma
     from ..fem.material_stage import make_material
     from ..fem.modal_stage import SCHEMA as MODAL_SCHEMA
     from ..schema import validate as validate_table
-    from .stage import SCHEMA as REPORT_SCHEMA
-    from .study import evaluate, write_study
 
     for need in ("geometry", "material"):
         if need not in params:
