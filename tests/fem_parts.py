@@ -3,7 +3,7 @@
 import numpy as np
 
 from crankmodal.fem import testparts
-from crankmodal.part import Cylinder, Part
+from crankmodal.part import CylindricalSurface, Part
 
 bar = testparts.bar
 tube = testparts.tube
@@ -50,6 +50,6 @@ def gmsh_rod(length=0.6, radius=0.02, size=0.012, order=2, tmp_path=None) -> Par
         "end_x1": testparts.region("end_x1", pts, cells, fac, lambda c: c[:, 0] > length - tol),
         "surface": testparts.region(
             "surface", pts, cells, fac, lambda c: (c[:, 0] > tol) & (c[:, 0] < length - tol),
-            cylinder=Cylinder(np.array([length / 2, 0, 0]), np.array([1.0, 0, 0]), radius, length)),
+            cylinder=CylindricalSurface(np.array([length / 2, 0, 0]), np.array([1.0, 0, 0]), radius, length)),
     }
     return Part(name="rod", mesh=mesh, regions=regions, fidelity="full")

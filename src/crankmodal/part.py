@@ -14,8 +14,12 @@ import numpy as np
 
 
 @dataclass(frozen=True)
-class Cylinder:
-    """Exact geometry of a cylindrical region (a bearing bore or journal surface).
+class CylindricalSurface:
+    """Exact geometry of a cylindrical boundary surface of a part (a bearing bore or a journal).
+
+    A geometric surface, not a cylinder of a machine (that is
+    :class:`crankmodal.mechanism.machine.Cylinder`, and its multibody form
+    :class:`crankmodal.dynamics.Cylinder`). Formerly named ``Cylinder``: that name stays an alias.
 
     Attributes
     ----------
@@ -43,6 +47,11 @@ class Cylinder:
         }
 
 
+#: Former name of :class:`CylindricalSurface`, kept so that code importing it and parts pickled
+#: under it (the geometry cache) still load. New code: :class:`CylindricalSurface`.
+Cylinder = CylindricalSurface
+
+
 @dataclass
 class Region:
     """A named boundary region of a part.
@@ -56,14 +65,14 @@ class Region:
     nodes : ndarray of int
         Sorted unique indices of every mesh node on those facets (mid-side nodes included for
         second-order meshes).
-    cylinder : Cylinder or None
-        Exact cylinder the region lies on, when known from the geometry.
+    cylinder : CylindricalSurface or None
+        Exact cylindrical surface the region lies on, when known from the geometry.
     """
 
     name: str
     facets: np.ndarray
     nodes: np.ndarray
-    cylinder: Cylinder | None = None
+    cylinder: CylindricalSurface | None = None
 
     def area(self, points: np.ndarray) -> float:
         """Sum of the flat facet areas, m² (slightly below a curved surface's true area)."""

@@ -26,6 +26,11 @@ from .system import Multibody
 class Cylinder:
     """One cylinder of a crank train (SI units, angles in rad).
 
+    The multibody form of a machine's cylinder (:class:`crankmodal.mechanism.machine.Cylinder`,
+    from which :meth:`from_machine` builds it): the axis at ``axis_angle`` from +x
+    counter-clockwise, with the rod it drives and its gas force as a function. Not a geometric
+    surface (:class:`crankmodal.part.CylindricalSurface`).
+
     ``rod_com`` is the distance of the rod's centre of mass from the big-end centre; ``offset``
     the piston-pin offset across the cylinder axis (positive towards +90 deg from the axis);
     ``z`` the axial row position along the crankpin (for 3D moments).
@@ -41,6 +46,43 @@ class Cylinder:
     z: float = 0.0
     gas_force: object = None
     ring_friction: float = 0.0
+
+    @classmethod
+    def from_machine(cls, machine, cylinder, gas_force=None,
+                     ring_friction: float = 0.0) -> Cylinder:
+        """The crank-train cylinder of one cylinder line of a machine.
+
+        :mod:`crankmodal.mechanism` measures a bank angle ``phi`` from +y towards +x; the
+        dynamics plane measures axes from +x counter-clockwise, so the axis angle is
+        ``pi/2 - phi`` (and the crank turns with ``direction = -1``). The rod is the machine's,
+        the row position its axial offset.
+
+        Parameters
+        ----------
+        machine : crankmodal.mechanism.machine.Machine
+            Gives the rod (length m, mass kg, inertia kg m², centre of mass from the big end m).
+        cylinder : crankmodal.mechanism.machine.Cylinder
+            One of ``machine.cylinders``; its crankpin must be the shared one (throw angle 0).
+        gas_force : callable, optional
+            Gas force on the piston against crank angle (see :mod:`crankmodal.dynamics.loads`).
+        ring_friction : float
+            Coulomb ring friction force, N.
+
+        Raises
+        ------
+        ParameterError
+            ``cylinder.throw_angle`` is not 0 (:func:`crank_train` puts every rod on one pin).
+        """
+        if abs(cylinder.throw_angle) > 0.0:
+            from ..errors import ParameterError
+
+            raise ParameterError("cylinder.throw_angle", "cylinders on separate crank throws are "
+                                 f"not supported yet (must be 0, got {cylinder.throw_angle})")
+        rod = machine.rod
+        return cls(axis_angle=np.pi / 2 - cylinder.bank_angle, rod_length=rod.length,
+                   rod_mass=rod.mass, rod_inertia=rod.inertia, rod_com=rod.cg_from_big_end,
+                   piston_mass=cylinder.piston_mass, z=cylinder.axial_offset,
+                   gas_force=gas_force, ring_friction=ring_friction)
 
 
 @dataclass

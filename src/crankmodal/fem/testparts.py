@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..part import Cylinder, MassProperties, Part, Region
+from ..part import CylindricalSurface, MassProperties, Part, Region
 from ..topology import TET10_EDGES, boundary_facets, facet_nodes
 
 
@@ -76,8 +76,8 @@ def tube(inner_radius=0.05, outer_radius=0.1, length=0.1, divisions=(4, 16, 2),
          angle=2 * np.pi, order=2) -> Part:
     """A thick tube along z (a full ring, or a sector of ``angle`` rad starting at +x).
 
-    Regions: ``bore`` (r = inner, with its Cylinder), ``outer`` (with its Cylinder), ``end_z0``,
-    ``end_z1``, and for a sector ``cut_0`` (y = 0) and ``cut_1`` (the other cut).
+    Regions: ``bore`` (r = inner, with its CylindricalSurface), ``outer`` (with its
+    CylindricalSurface), ``end_z0``, ``end_z1``, and for a sector ``cut_0`` (y = 0) and ``cut_1`` (the other cut).
     """
     full = np.isclose(angle, 2 * np.pi)
     p, t = _grid(divisions)
@@ -100,7 +100,8 @@ def tube(inner_radius=0.05, outer_radius=0.1, length=0.1, divisions=(4, 16, 2),
     fac = boundary_facets(cells)
     tol = 1e-6 * b
     rad = lambda c: np.hypot(c[:, 0], c[:, 1])
-    cyl = lambda R: Cylinder(np.array([0, 0, length / 2]), np.array([0.0, 0, 1]), R, length)
+    cyl = lambda R: CylindricalSurface(np.array([0, 0, length / 2]), np.array([0.0, 0, 1]), R,
+                                       length)
     # facet centroids of a curved surface lie slightly inside it: select by node radii instead
     rmin = np.hypot(*pts[fac][:, :, :2].transpose(2, 0, 1)).min(axis=1)
     rmax = np.hypot(*pts[fac][:, :, :2].transpose(2, 0, 1)).max(axis=1)

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GeometryError, InputFileError
-from ..part import Cylinder, Part, Region
+from ..part import CylindricalSurface, Part, Region
 from ..topology import boundary_facets, facet_nodes
 from .mesh import MeshSettings
 from .regions import RegionSpec
@@ -101,7 +101,7 @@ def _geometric_regions(points, cells, specs: list) -> dict:
             cyl = None
             if np.any(inside):
                 t0, t1 = along[inside].min(), along[inside].max()
-                cyl = Cylinder(centre=p0 + 0.5 * (t0 + t1) * d, axis=d, radius=s.radius, length=float(t1 - t0))
+                cyl = CylindricalSurface(centre=p0 + 0.5 * (t0 + t1) * d, axis=d, radius=s.radius, length=float(t1 - t0))
         if not np.any(inside):
             raise GeometryError(f"region {s.name!r}: no boundary facet of the mesh lies on its definition")
         out[s.name] = _region(s.name, cells, facets[inside], cyl)

@@ -3,7 +3,7 @@
 A :class:`RegionSpec` says where a region lies (a cylinder about an axis parallel to z, or a
 plane z = const); :func:`tag_regions` finds the matching faces on the synchronised gmsh model
 and makes one physical surface group per region; :func:`regions_from_mesh` turns the meshed
-groups into :class:`crankmodal.part.Region` objects with the exact :class:`~crankmodal.part.Cylinder`.
+groups into :class:`crankmodal.part.Region` objects with the exact :class:`~crankmodal.part.CylindricalSurface`.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import GeometryError
-from ..part import Cylinder, Region
+from ..part import CylindricalSurface, Region
 
 #: Relative tolerance of geometric face matching.
 TOL = 1e-6
@@ -129,13 +129,13 @@ def tag_regions(gmsh, specs: list, required: bool = True) -> dict:
     return out
 
 
-def exact_cylinder(gmsh, spec: RegionSpec, faces: list) -> Cylinder | None:
+def exact_cylinder(gmsh, spec: RegionSpec, faces: list) -> CylindricalSurface | None:
     """The exact cylinder a region lies on, with the axial extent of its faces."""
     if spec.kind == "cylinder":
         boxes = np.array([gmsh.model.getBoundingBox(2, s) for s in faces])
         z0 = max(boxes[:, 2].min(), spec.z_range[0])  # bounding boxes carry a 1e-7 slack
         z1 = min(boxes[:, 5].max(), spec.z_range[1])
-        return Cylinder(centre=np.array([spec.axis_xy[0], spec.axis_xy[1], 0.5 * (z0 + z1)]),
+        return CylindricalSurface(centre=np.array([spec.axis_xy[0], spec.axis_xy[1], 0.5 * (z0 + z1)]),
                         axis=np.array([0.0, 0.0, 1.0]), radius=float(spec.radius), length=float(z1 - z0))
     if spec.kind == "cylinder_axis":
         p0, d = spec.axis_xy[:3], spec.axis_xy[3:] / np.linalg.norm(spec.axis_xy[3:])
@@ -144,7 +144,7 @@ def exact_cylinder(gmsh, spec: RegionSpec, faces: list) -> Cylinder | None:
             pts = _sample(gmsh, s, 9)
             t += list((pts - p0) @ d)
         t0, t1 = min(t), max(t)
-        return Cylinder(centre=p0 + 0.5 * (t0 + t1) * d, axis=d, radius=float(spec.radius), length=float(t1 - t0))
+        return CylindricalSurface(centre=p0 + 0.5 * (t0 + t1) * d, axis=d, radius=float(spec.radius), length=float(t1 - t0))
     return None
 
 

@@ -55,7 +55,12 @@ class Rod:
 
 @dataclass(frozen=True)
 class Cylinder:
-    """One cylinder line.
+    """One cylinder line of a machine: where its axis lies, its piston and its gas process.
+
+    The multibody dynamics takes the same cylinder as :class:`crankmodal.dynamics.Cylinder`
+    (built from this one by :meth:`crankmodal.dynamics.Cylinder.from_machine`: the axis in the
+    dynamics' angle convention, with the rod it drives and its gas force as a function). Not a
+    geometric surface (:class:`crankmodal.part.CylindricalSurface`).
 
     Attributes
     ----------

@@ -1,8 +1,8 @@
 """Bearing interfaces: one 6-DOF interface node per region, tied rigidly or by a distributing coupling.
 
-An interface node sits at the exact centre of a bore (the Region's :class:`~crankmodal.part.Cylinder`,
-not a mesh average). Its six coordinates ``q = (t, θ)`` (m, rad) are tied to the region's surface
-nodes in one of two ways:
+An interface node sits at the exact centre of a bore (the Region's
+:class:`~crankmodal.part.CylindricalSurface`, not a mesh average). Its six coordinates
+``q = (t, θ)`` (m, rad) are tied to the region's surface nodes in one of two ways:
 
 ``rigid`` (RBE2-like)
     Every surface node follows the rigid motion of the node, ``u_i = t + θ × (x_i − c)``. The
@@ -114,8 +114,8 @@ def _is_planar(points: np.ndarray, facets: np.ndarray) -> bool:
 def interface_centre(points: np.ndarray, region, cells: np.ndarray):
     """Centre, axis, radius and source of an interface on ``region``.
 
-    The region's exact Cylinder when it has one; else a least-squares cylinder fit; else (a
-    planar end face, say) the area centroid of the surface.
+    The region's exact CylindricalSurface when it has one; else a least-squares cylinder fit;
+    else (a planar end face, say) the area centroid of the surface.
     """
     from ..fem.supports import fit_cylinder
 
@@ -180,11 +180,11 @@ def split_region(region, points: np.ndarray, segments: int, cells: np.ndarray):
     """Cut a cylindrical region into ``segments`` equal axial bands (e.g. two rods on one pin).
 
     Returns a list of :class:`~crankmodal.part.Region` named ``<name>_seg<k>`` (k from 1), each
-    with its own exact Cylinder (centre shifted along the axis, length / segments). Nodes on a
-    cut line belong to the lower band only, so rigid bands do not overlap.
+    with its own exact CylindricalSurface (centre shifted along the axis, length / segments).
+    Nodes on a cut line belong to the lower band only, so rigid bands do not overlap.
     """
     from ..fem.supports import fit_cylinder
-    from ..part import Cylinder, Region
+    from ..part import CylindricalSurface, Region
 
     cyl = region.cylinder or fit_cylinder(points, np.asarray(region.facets))
     a = np.asarray(cyl.axis, float) / np.linalg.norm(cyl.axis)
@@ -202,7 +202,8 @@ def split_region(region, points: np.ndarray, segments: int, cells: np.ndarray):
         nodes = np.setdiff1d(nodes, taken)  # a node on a cut belongs to the first band
         taken = np.union1d(taken, nodes)
         out.append(Region(name=f"{region.name}_seg{k + 1}", facets=f, nodes=nodes,
-                          cylinder=Cylinder(c0 + mid * a, a, cyl.radius, cyl.length / segments)))
+                          cylinder=CylindricalSurface(c0 + mid * a, a, cyl.radius,
+                                                      cyl.length / segments)))
     return out
 
 
