@@ -1,6 +1,11 @@
 """Consistent nodal loads on boundary regions: pressure, total force, remote force (RBE3), and
 a pin's force on a bore (bearing load).
 
+:class:`Load` is the user-facing object: ``Load.bearing(part, "small_end_bore", force=[F, 0, 0])``,
+``Load.pressure``, ``Load.traction``, ``Load.remote`` on a region (by name, or the boundary
+facets inside a box), holding the nodal force vector and a label; loads add. The functions below
+it work on bare arrays (points, cells, facets) and return the nodal vector.
+
 Region facets are corner triangles; on a ``tetra10`` mesh their mid-edge nodes are looked up in
 the volume connectivity and the 6-node facets are integrated isoparametrically (a pressure on a
 curved bore pushes along the true normal). Facets are oriented outward from the owning element.
@@ -8,9 +13,11 @@ curved bore pushes along the true normal). Facets are oriented outward from the 
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import GeometryError, ParameterError
 from ..topology import facet_midnodes
 
 _TET_FACES = np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]])
@@ -46,7 +53,7 @@ def oriented_facets(cells: np.ndarray, facets: np.ndarray) -> np.ndarray:
     pos = np.searchsorted(fk_sorted, q)
     pos = np.minimum(pos, len(fk_sorted) - 1)
     if np.any(fk_sorted[pos] != q):
-        raise SceneError("region: a facet is not a face of any element")
+        raise GeometryError("region: a facet is not a face of any element")
     idx = order[pos]
     tet, face = idx // 4, idx % 4
     opp = cells[tet, _TET_OPPOSITE[face]]
@@ -159,7 +166,9 @@ def bearing_load(points, cells, facets, force, axis) -> np.ndarray:
     shell pressing a journal (a crankpin) loads the journal on the side facing away from it.
     Where cos θ ≤ 0 there is no pressure — the usual "bearing load" of a strength check
     (no clearance, no friction). ``p0`` is set so that the nodal forces add up to the force
-    exactly (analytically ``p0 = 2 |F| / (π R L)``).
+    along it (analytically ``p0 = 2 |F| / (π R L)``); what a mesh that is not symmetric about the
+    force leaves across it or along the axis is spread over the loaded facets as a uniform
+    traction, so the nodal forces add up to the force to round-off.
 
     Parameters
     ----------
@@ -167,6 +176,11 @@ def bearing_load(points, cells, facets, force, axis) -> np.ndarray:
         N, perpendicular to the axis (a pressure on a cylinder carries no axial force).
     axis : (3,) array
         The cylinder's axis direction (the force must be perpendicular to it).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``force`` when it has a component along the axis.
     """
     F = np.asarray(force, float)
     d = np.asarray(axis, float) / np.linalg.norm(axis)
@@ -174,8 +188,8 @@ def bearing_load(points, cells, facets, force, axis) -> np.ndarray:
     if fn == 0.0:
         return np.zeros(3 * len(points))
     if abs(F @ d) > 1e-6 * fn:
-        raise SceneError(f"bearing_force: {F.tolist()} N has {F @ d:.4g} N along the bore axis; "
-                         f"a bearing load is radial (give the axial part as a force)")
+        raise ParameterError("force", f"{F.tolist()} N has {F @ d:.4g} N along the bore axis; "
+                                      f"a bearing load is radial (give the axial part as a force)")
     fhat = F / fn
     nodes, N, nda = facet_quadrature(points, cells, facets)  # outward normal x area weight
     da = np.linalg.norm(nda, axis=2)
@@ -183,4 +197,239 @@ def bearing_load(points, cells, facets, force, axis) -> np.ndarray:
     t = -c[..., None] * nda  # traction per unit p0 (pushing into the surface), times the weight
     p0 = fn / float(np.einsum("fqc,c->", t, fhat))
     vals = p0 * np.einsum("qk,fqc->fkc", N, t)
-    return _scatter(len(points), nodes, vals)
+    f = _scatter(len(points), nodes, vals)
+    # a mesh not symmetric about F leaves the pressure's resultant off F across F and along the
+    # axis (5e-5 |F| on the rod's small eye at 8 mm); that remainder goes to the loaded facets as
+    # a uniform traction, so the nodal forces add up to F to round-off
+    rest = F - f.reshape(-1, 3).sum(axis=0)
+    loaded = np.asarray(facets)[(c > 0).any(axis=1)]
+    return f + traction_force(points, cells, loaded, rest)
+
+
+# --- the user-facing object ---------------------------------------------------------------------
+
+def _vector3(value, argument: str) -> np.ndarray:
+    """Three finite numbers as a float array; :class:`ParameterError` naming ``argument``."""
+    try:
+        v = np.asarray(value, float)
+    except (TypeError, ValueError):
+        v = None
+    if v is None or v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ParameterError(argument, f"must be 3 finite numbers, got {value!r}")
+    return v
+
+
+def _mesh_arrays(part) -> tuple[np.ndarray, np.ndarray]:
+    """The part's points (n, 3), m, and its volume cells (tetra or tetra10)."""
+    from .assembly import _volume_block
+
+    return (np.asarray(part.mesh.points, float)[:, :3],
+            np.asarray(_volume_block(part.mesh).data, np.int64))
+
+
+def region_facets(part, region, cells: np.ndarray | None = None):
+    """Boundary facets of ``region``: a region name, or a box ``[xmin, xmax, ..., zmax]`` (m).
+
+    A box takes the boundary facets whose three corners lie inside it (bounds included).
+
+    Returns
+    -------
+    facets : ndarray (n, 3)
+        Corner triangles.
+    where : Region or None
+        The named region (None for a box).
+    name : str
+        For labels: the region's name or ``box``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``region``: no such region, a malformed box, or a box holding no boundary facet.
+    """
+    from .supports import _checked_box, part_region
+
+    if isinstance(region, str):
+        reg = part_region(part, region, "region")
+        return np.asarray(reg.facets), reg, region
+    if not isinstance(region, (list, tuple, np.ndarray)):
+        raise ParameterError("region", f"must be a region name or a box [xmin, xmax, ymin, ymax, "
+                                       f"zmin, zmax] (m), got {region!r}")
+    try:
+        box = _checked_box(region, "")
+    except ParameterError as exc:
+        raise ParameterError("region", exc.text) from None
+    from ..topology import boundary_facets
+
+    points = np.asarray(part.mesh.points, float)[:, :3]
+    facets = boundary_facets(_mesh_arrays(part)[1] if cells is None else cells)
+    lo, hi = np.array(box[0::2]), np.array(box[1::2])
+    inside = np.all((points[facets] >= lo) & (points[facets] <= hi), axis=(1, 2))
+    if not inside.any():
+        raise ParameterError("region", f"the box {box} holds no boundary facet of part "
+                                       f"{part.name!r}")
+    return facets[inside], None, "box"
+
+
+@dataclass
+class Load:
+    """Nodal forces on a part's mesh points: plain data that adds (``load1 + load2``).
+
+    Make one with :meth:`pressure`, :meth:`traction`, :meth:`remote` or :meth:`bearing` on a
+    region (its name, or a box ``[xmin, xmax, ymin, ymax, zmin, zmax]`` taking the boundary
+    facets inside), or from a vector of your own.
+
+    Attributes
+    ----------
+    vector : ndarray, shape (3 n_points,)
+        Nodal forces, N, node-interleaved (``3 * point + component``), as :func:`solve_static`
+        and ``FEModel.K`` take them.
+    label : str
+        What it is, e.g. ``bearing on small_end_bore``.
+    points : ndarray (n_points, 3) or None
+        The mesh points, m (for :meth:`moment`); not copied.
+    """
+
+    vector: np.ndarray
+    label: str = "load"
+    points: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def forces(self) -> np.ndarray:
+        """Nodal forces, N, shape (n_points, 3)."""
+        return np.asarray(self.vector).reshape(-1, 3)
+
+    @property
+    def resultant(self) -> np.ndarray:
+        """Total force, N, shape (3,)."""
+        return self.forces.sum(axis=0)
+
+    def moment(self, about=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Total moment of the nodal forces about a point (m), N m, shape (3,)."""
+        if self.points is None:
+            raise ParameterError("points", f"{self.label} has no mesh points to take moments with")
+        return np.cross(self.points - _vector3(about, "about"), self.forces).sum(axis=0)
+
+    def __add__(self, other) -> Load:
+        if isinstance(other, (int, float)) and other == 0:
+            return self  # sum([...]) starts from 0
+        if not isinstance(other, Load):
+            return NotImplemented
+        if np.shape(other.vector) != np.shape(self.vector):
+            raise ParameterError("load", f"{other.label!r} has {np.size(other.vector)} entries, "
+                                         f"{self.label!r} {np.size(self.vector)}: loads on "
+                                         f"different meshes do not add")
+        points = self.points if self.points is not None else other.points
+        return Load(np.asarray(self.vector) + np.asarray(other.vector),
+                    f"{self.label} + {other.label}", points)
+
+    __radd__ = __add__
+
+    def __mul__(self, factor: float) -> Load:
+        if isinstance(factor, bool) or not isinstance(factor, (int, float)):
+            return NotImplemented
+        return Load(factor * np.asarray(self.vector), f"{factor:.4g} × {self.label}", self.points)
+
+    __rmul__ = __mul__
+
+    @classmethod
+    def pressure(cls, part, region, pressure: float) -> Load:
+        """A uniform pressure, Pa, positive pushing into the surface.
+
+        Raises
+        ------
+        ParameterError
+            Naming ``region`` or ``pressure`` (not a finite number).
+        """
+        if (isinstance(pressure, bool) or not isinstance(pressure, (int, float, np.floating))
+                or not np.isfinite(pressure)):
+            raise ParameterError("pressure", f"must be a number (Pa), got {pressure!r}")
+        points, cells = _mesh_arrays(part)
+        facets, _, name = region_facets(part, region, cells)
+        return cls(pressure_load(points, cells, facets, float(pressure)),
+                   f"pressure {pressure:.4g} Pa on {name}", points)
+
+    @classmethod
+    def traction(cls, part, region, force) -> Load:
+        """A total force, N (3-vector), spread over the region as a uniform traction.
+
+        Raises
+        ------
+        ParameterError
+            Naming ``region`` or ``force``.
+        """
+        F = _vector3(force, "force")
+        points, cells = _mesh_arrays(part)
+        facets, _, name = region_facets(part, region, cells)
+        return cls(traction_force(points, cells, facets, F), f"traction on {name}", points)
+
+    @classmethod
+    def remote(cls, part, region, force, point=None, moment=None) -> Load:
+        """A force (N) at ``point`` (m; default the region's area centroid) plus a moment (N m),
+        carried to the region by a distributing (RBE3-type) coupling: the nodal forces add up
+        to ``force`` and their moment about ``point`` is ``moment``.
+
+        Raises
+        ------
+        ParameterError
+            Naming ``region``, ``force``, ``point`` or ``moment``.
+        """
+        F = _vector3(force, "force")
+        P = None if point is None else _vector3(point, "point")
+        M = None if moment is None else _vector3(moment, "moment")
+        points, cells = _mesh_arrays(part)
+        facets, _, name = region_facets(part, region, cells)
+        return cls(remote_force(points, cells, facets, F, P, M), f"remote force on {name}",
+                   points)
+
+    @classmethod
+    def bearing(cls, part, region, force) -> Load:
+        """A pin's radial force (N) on a cylindrical bore or journal, as a pressure ``p0 cos θ``
+        on the half it presses (see :func:`bearing_load`); the nodal forces add up to ``force``.
+
+        Raises
+        ------
+        ParameterError
+            Naming ``region`` (absent, or not cylindrical) or ``force`` (along the axis).
+        """
+        from .supports import fit_cylinder, region_cylinder
+
+        F = _vector3(force, "force")
+        points, cells = _mesh_arrays(part)
+        facets, reg, name = region_facets(part, region, cells)
+        if reg is not None:
+            axis = region_cylinder(reg, name, points, "region").axis
+        else:
+            try:
+                axis = fit_cylinder(points, facets).axis
+            except ValueError as exc:
+                raise ParameterError("region", f"needs a cylindrical region; the box's facets "
+                                               f"are {exc}") from None
+        return cls(bearing_load(points, cells, facets, F, axis), f"bearing on {name}", points)
+
+
+def as_vector(load, n_points: int) -> np.ndarray:
+    """The nodal force vector (3 n_points,), N, of a :class:`Load`, a list of loads or vectors
+    (summed), or a vector.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``load`` when it is none of these or not of length 3 n_points.
+    """
+    if isinstance(load, (list, tuple)) and load and all(
+            isinstance(x, (Load, np.ndarray)) for x in load):
+        parts = [as_vector(x, n_points) for x in load]
+        return np.sum(parts, axis=0)
+    v = load.vector if isinstance(load, Load) else load
+    try:
+        v = np.asarray(v, float)
+    except (TypeError, ValueError):
+        raise ParameterError("load", f"must be a Load, a list of them, or a vector of "
+                                     f"3 n_points = {3 * n_points} nodal forces (N); got "
+                                     f"{type(load).__name__}") from None
+    if v.shape != (3 * n_points,):
+        raise ParameterError("load", f"must have 3 n_points = {3 * n_points} entries (nodal "
+                                     f"forces, N), got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ParameterError("load", "holds non-finite values")
+    return v

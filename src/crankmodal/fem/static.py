@@ -12,8 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import ParameterError
 from .assembly import FEModel, skfem_mesh
+from .loads import Load, as_vector
 from .supports import Support, reduce_matrix, reduction
 
 
@@ -120,38 +121,46 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
     return np.sqrt(1.5 * np.einsum("...ij,...ij->...", dev, dev))
 
 
-def solve_static(model: FEModel, mesh, load: np.ndarray, supports: list[Support],
+def solve_static(model: FEModel, mesh, load: Load | list | np.ndarray, supports: list[Support],
                  backend: str = "auto") -> StaticResult:
-    """Displacements and stresses under a load vector.
+    """Displacements and stresses under a load.
 
     Parameters
     ----------
     model : FEModel
     mesh : meshio.Mesh
         The part's mesh.
-    load : ndarray, shape (3 n_points,)
-        Nodal forces, N.
+    load : Load, list of Load, or ndarray of shape (3 n_points,)
+        Nodal forces, N (a list is summed).
     supports : list of Support
         Must remove every rigid-body mode.
     backend : str
 
     Raises
     ------
-    SceneError
-        If the supports leave a mechanism (names how many rigid-body modes remain).
+    ParameterError
+        Naming ``supports`` if they leave a mechanism (with how many rigid-body modes remain) or
+        are not :class:`Support` objects, ``load`` if it is not a load of this mesh.
     """
     from ..progress import PhaseTimings
     from .modal import expected_rigid_modes
     from .solvers import factorize
 
+    load = as_vector(load, len(model.points))
+    supports = list(supports)
+    for i, s in enumerate(supports):
+        if not isinstance(s, Support):
+            raise ParameterError(f"supports[{i}]", f"must be a Support (Support.region, "
+                                                   f"Support.box or select_supports), got "
+                                                   f"{type(s).__name__}")
     timings = PhaseTimings("static", 3)
     t0 = time.perf_counter()
-    T = reduction(model.points, model.used, list(supports))
+    T = reduction(model.points, model.used, supports)
     free_rigid = expected_rigid_modes(model, T)
     if free_rigid:
-        raise SceneError(f"static.supports: leave the part a mechanism with {free_rigid} "
-                         f"rigid-body mode(s); fix more components (e.g. fix = 'xyz' on one "
-                         f"region) before a static solve")
+        raise ParameterError("supports", f"leave the part a mechanism with {free_rigid} "
+                                         f"rigid-body mode(s); fix more components (e.g. fix = "
+                                         f"'xyz' on one region) before a static solve")
     K = reduce_matrix(model.K, T)
     timings["reduce_s"] = time.perf_counter() - t0
     t0 = time.perf_counter()

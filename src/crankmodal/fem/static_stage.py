@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import SceneError, scene_keys
 from ..schema import Field
 from ..schema import validate as validate_table
 from .stage_common import BACKEND_FIELD, fe_model, part_and_material
@@ -79,35 +79,47 @@ def validate(raw: dict, scene) -> dict:
     return p
 
 
+def scene_loads(part, loads) -> list:
+    """A :class:`~crankmodal.fem.loads.Load` per (validated) load table, labelled by its key.
+
+    Raises
+    ------
+    SceneError
+        Naming ``static.loads[i].<key>`` (an unknown region; a bearing force on a region that is
+        not cylindrical or along its axis).
+    """
+    from .loads import Load
+    from .supports import part_region
+
+    out = []
+    for i, ld in enumerate(loads):
+        key = f"loads[{i}]"
+        kind = ld["kind"]
+        with scene_keys(SECTION, {"region": f"{key}.region"}):
+            part_region(part, ld["region"])
+        # the value's own key: a bearing load's region that is no bore is its bearing_force's fault
+        keys = {"force": f"{key}.{kind}", "region": f"{key}.{kind}", "pressure": f"{key}.pressure",
+                "point": f"{key}.point", "moment": f"{key}.moment"}
+        with scene_keys(SECTION, keys):
+            if kind == "pressure":
+                load = Load.pressure(part, ld["region"], float(ld["pressure"]))
+            elif kind == "force":
+                load = Load.traction(part, ld["region"], ld["force"])
+            elif kind == "bearing_force":
+                load = Load.bearing(part, ld["region"], ld["bearing_force"])
+            else:
+                load = Load.remote(part, ld["region"], ld["remote_force"], ld.get("point"),
+                                   ld.get("moment"))
+        load.label = f"{SECTION}.{key} ({load.label})"
+        out.append(load)
+    return out
+
+
 def load_vector(part, model, loads) -> np.ndarray:
     """Sum of the nodal forces of every load table, N, shape (3 n_points,)."""
-    from . import loads as L
+    from .loads import as_vector
 
-    f = np.zeros(3 * len(model.points))
-    for i, ld in enumerate(loads):
-        name = ld["region"]
-        if name not in part.regions:
-            raise SceneError(f"{SECTION}.loads[{i}].region: no region {name!r} in part "
-                             f"{part.name!r}; regions: {', '.join(sorted(part.regions)) or 'none'}")
-        facets = np.asarray(part.regions[name].facets)
-        if ld["kind"] == "pressure":
-            f += L.pressure_load(model.points, model.cells, facets, float(ld["pressure"]))
-        elif ld["kind"] == "force":
-            f += L.traction_force(model.points, model.cells, facets, ld["force"])
-        elif ld["kind"] == "bearing_force":
-            from .supports import region_cylinder
-
-            cyl = region_cylinder(part.regions[name], name, model.points,
-                                  f"{SECTION}.loads[{i}].bearing_force:")
-            try:
-                f += L.bearing_load(model.points, model.cells, facets, ld["bearing_force"],
-                                    cyl.axis)
-            except SceneError as exc:
-                raise SceneError(f"{SECTION}.loads[{i}].{exc}") from None
-        else:
-            f += L.remote_force(model.points, model.cells, facets, ld["remote_force"],
-                                ld.get("point"), ld.get("moment"))
-    return f
+    return as_vector(scene_loads(part, loads), len(model.points))
 
 
 def run(p: dict, ctx) -> dict:
@@ -117,8 +129,10 @@ def run(p: dict, ctx) -> dict:
     part, mat = part_and_material(ctx, SECTION)
     model = fe_model(ctx, part, mat)
     sup = select(part, p["supports"], SECTION)
-    f = load_vector(part, model, p["loads"])
-    res = solve_static(model, part.mesh, f, sup, backend=p["backend"])
+    loads = scene_loads(part, p["loads"])
+    with scene_keys(SECTION):
+        res = solve_static(model, part.mesh, loads, sup, backend=p["backend"])
+    f = sum(ld.vector for ld in loads)
     ctx.products[SECTION] = res
     out = res.to_dict()
     out["applied_force_n"] = f.reshape(-1, 3).sum(axis=0)

@@ -7,6 +7,12 @@ about it, but not move towards or away from it). Every constraint is a direction
 ``u = T q`` with ``T`` sparse and orthonormal column by column. ``Tᵀ K T``, ``Tᵀ M T`` are the
 supported matrices: exact elimination, no penalty to tune, positive definite when the supports
 remove every rigid-body mode.
+
+From Python a support is made directly, ``Support.region(part, "big_end_bore", fix="xyz")`` or
+``Support.box(part, [xmin, xmax, ymin, ymax, zmin, zmax], fix="x")``; :func:`select_supports`
+also takes the scene's tables (``{region = ..., fix = ...}``). These raise
+:class:`~crankmodal.errors.ParameterError` naming the argument (``fix``, ``supports[1].region``);
+:func:`select` is the stages' form, naming the scene key (``modal.supports[1].region``).
 """
 
 from __future__ import annotations
@@ -16,14 +22,21 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import SceneError
+from ..errors import ParameterError, SceneError, scene_keys
 
 AXES = "xyz"
+
+
+def _arg(key: str, name: str) -> str:
+    """``key.name``, or ``name`` alone at the top level (``key`` empty)."""
+    return f"{key}.{name}" if key else name
 
 
 @dataclass
 class Support:
     """Nodes and the components fixed on them.
+
+    Make one with :meth:`Support.region` or :meth:`Support.box` (or :func:`select_supports`).
 
     Attributes
     ----------
@@ -42,6 +55,54 @@ class Support:
     fix: str
     cylinder: object = None
 
+    @classmethod
+    def region(cls, part, name: str, fix: str = "xyz", label: str | None = None) -> Support:
+        """The nodes of the part's region ``name``, with ``fix`` held.
+
+        Parameters
+        ----------
+        part : Part
+        name : str
+            A key of ``part.regions``.
+        fix : str
+            Distinct letters of ``x``, ``y``, ``z`` (global components held), or ``"radial"``
+            (a cylindrical region: no motion towards or away from its axis).
+        label : str, optional
+            For messages; default ``region <name>``.
+
+        Raises
+        ------
+        ParameterError
+            Naming ``region`` (no such region) or ``fix`` (inadmissible, or ``radial`` on a
+            region that is not cylindrical).
+        """
+        return _region_support(part, name, _checked_fix(fix, ""), "", label)
+
+    @classmethod
+    def box(cls, part, box, fix: str = "xyz", label: str | None = None) -> Support:
+        """The part's mesh points inside ``box`` (bounds included), with ``fix`` held.
+
+        Parameters
+        ----------
+        part : Part
+        box : sequence of 6 float
+            ``[xmin, xmax, ymin, ymax, zmin, zmax]``, m.
+        fix : str
+            Distinct letters of ``x``, ``y``, ``z`` (``radial`` needs a region).
+        label : str, optional
+            For messages; default ``box``.
+
+        Raises
+        ------
+        ParameterError
+            Naming ``box`` (malformed, or holding no node) or ``fix``.
+        """
+        fix = _checked_fix(fix, "")
+        box = _checked_box(box, "")
+        if fix == "radial":
+            raise ParameterError("fix", "'radial' needs a cylindrical region, not a box")
+        return _box_support(part, box, fix, "", label)
+
 
 def check_fix(fix: str) -> str | None:
     """Error text for an inadmissible ``fix`` value, or None."""
@@ -50,6 +111,65 @@ def check_fix(fix: str) -> str | None:
     if not isinstance(fix, str) or not fix or set(fix) - set(AXES) or len(set(fix)) != len(fix):
         return f"fix must be 'radial' or distinct letters of x, y, z (e.g. 'xz'); got {fix!r}"
     return None
+
+
+def _checked_fix(fix, key: str) -> str:
+    msg = check_fix(fix)
+    if msg:
+        raise ParameterError(_arg(key, "fix"), msg)
+    return fix
+
+
+def _checked_box(box, key: str) -> list:
+    if (not isinstance(box, (list, tuple, np.ndarray)) or len(box) != 6
+            or not all(isinstance(b, (int, float, np.integer, np.floating))
+                       and not isinstance(b, bool) for b in box)):
+        raise ParameterError(_arg(key, "box"),
+                             f"must be [xmin, xmax, ymin, ymax, zmin, zmax] in m, got {box!r}")
+    if any(a > b for a, b in zip(box[0::2], box[1::2])):
+        raise ParameterError(_arg(key, "box"), f"each min must be <= its max, got {box!r}")
+    return [float(b) for b in box]
+
+
+def _points(part) -> np.ndarray:
+    return np.asarray(part.mesh.points, float)[:, :3]
+
+
+def part_region(part, name, argument: str = "region"):
+    """``part.regions[name]``; raises :class:`ParameterError` naming ``argument`` if absent."""
+    if not isinstance(name, str):
+        raise ParameterError(argument, f"must be a region name, got {name!r}")
+    if name not in part.regions:
+        known = ", ".join(sorted(part.regions)) or "none"
+        raise ParameterError(argument, f"no region {name!r} in part {part.name!r}; "
+                                       f"regions: {known}")
+    return part.regions[name]
+
+
+def _region_support(part, name, fix, key, label):
+    reg = part_region(part, name, _arg(key, "region"))
+    nodes = np.asarray(reg.nodes, np.int64)
+    cyl = None
+    if fix == "radial":
+        cyl = region_cylinder(reg, name, _points(part), _arg(key, "fix"), "'radial' ")
+    _require_nodes(part, nodes, key or "region")
+    return Support(label=label or f"region {name}", nodes=nodes, fix=fix, cylinder=cyl)
+
+
+def _box_support(part, box, fix, key, label):
+    points = _points(part)
+    lo, hi = np.array(box[0::2], float), np.array(box[1::2], float)
+    nodes = np.flatnonzero(np.all((points >= lo) & (points <= hi), axis=1))
+    _require_nodes(part, nodes, key or "box")
+    return Support(label=label or "box", nodes=nodes, fix=fix)
+
+
+def _require_nodes(part, nodes, argument):
+    if len(nodes) == 0:
+        points = _points(part)
+        ext = np.column_stack([points.min(0), points.max(0)]).ravel()
+        raise ParameterError(argument, f"selects no node (part bounding box "
+                                       f"[{', '.join(f'{v:.4g}' for v in ext)}] m)")
 
 
 def fit_cylinder(points: np.ndarray, facets: np.ndarray):
@@ -82,102 +202,122 @@ def fit_cylinder(points: np.ndarray, facets: np.ndarray):
     return Cylinder(centre=centre, axis=axis, radius=float(radius), length=float(np.ptp(s)))
 
 
-def region_cylinder(region, name: str, points: np.ndarray, what: str):
+def region_cylinder(region, name: str, points: np.ndarray, argument: str, what: str = ""):
     """The region's exact cylinder from the geometry, else one fitted to its nodes.
 
-    Raises :class:`SceneError` starting with ``what`` when the region is not cylindrical.
+    Raises :class:`ParameterError` naming ``argument`` (its text starting with ``what``) when the
+    region is not cylindrical.
     """
     if region.cylinder is not None:
         return region.cylinder
     try:
         return fit_cylinder(points, np.asarray(region.facets))
     except ValueError as exc:
-        raise SceneError(f"{what} needs a cylindrical region; region {name!r} is {exc}") from None
+        raise ParameterError(argument, f"{what}needs a cylindrical region; region {name!r} is "
+                                       f"{exc}") from None
 
 
-def validate_specs(specs, section: str = "modal") -> list[dict]:
-    """Check support tables without a part; returns them with ``fix`` defaulted to ``xyz``.
+def check_specs(specs) -> list:
+    """Check support tables (and pass :class:`Support` objects) without a part.
+
+    Returns the list with each table's ``fix`` defaulted to ``xyz``.
 
     Raises
     ------
-    SceneError
-        Naming ``<section>.supports[i].<key>`` and what is allowed.
+    ParameterError
+        Naming ``supports[i].<key>`` and what is allowed.
     """
     if specs is None:
         return []
     if not isinstance(specs, (list, tuple)):
-        raise SceneError(f"{section}.supports: must be a list of tables, got {specs!r}")
+        raise ParameterError("supports", f"must be a list of tables, got {specs!r}")
     out = []
     for i, spec in enumerate(specs):
-        key = f"{section}.supports[{i}]"
+        key = f"supports[{i}]"
+        if isinstance(spec, Support):
+            out.append(spec)
+            continue
         if not isinstance(spec, dict):
-            raise SceneError(f"{key}: must be a table {{box = [...], fix = ...}} or "
-                             f"{{region = ..., fix = ...}}, got {spec!r}")
+            raise ParameterError(key, f"must be a table {{box = [...], fix = ...}} or "
+                                      f"{{region = ..., fix = ...}}, got {spec!r}")
         unknown = set(spec) - {"box", "region", "fix"}
         if unknown:
-            raise SceneError(f"{key}.{min(unknown)}: unknown key; allowed: box, region, fix")
+            raise ParameterError(f"{key}.{min(unknown)}", "unknown key; allowed: box, region, fix")
         if ("box" in spec) == ("region" in spec):
-            raise SceneError(f"{key}: give exactly one of 'box' or 'region'")
-        fix = spec.get("fix", "xyz")
-        msg = check_fix(fix)
-        if msg:
-            raise SceneError(f"{key}.fix: {msg}")
+            raise ParameterError(key, "give exactly one of 'box' or 'region'")
+        fix = _checked_fix(spec.get("fix", "xyz"), key)
         if "box" in spec:
-            box = spec["box"]
-            if (not isinstance(box, (list, tuple)) or len(box) != 6
-                    or not all(isinstance(b, (int, float)) and not isinstance(b, bool)
-                               for b in box)):
-                raise SceneError(f"{key}.box: must be [xmin, xmax, ymin, ymax, zmin, zmax] in m, "
-                                 f"got {box!r}")
-            if any(a > b for a, b in zip(box[0::2], box[1::2])):
-                raise SceneError(f"{key}.box: each min must be <= its max, got {box!r}")
+            _checked_box(spec["box"], key)
             if fix == "radial":
-                raise SceneError(f"{key}.fix: 'radial' needs a cylindrical region, not a box")
+                raise ParameterError(f"{key}.fix", "'radial' needs a cylindrical region, not a box")
         elif not isinstance(spec["region"], str):
-            raise SceneError(f"{key}.region: must be a region name, got {spec['region']!r}")
+            raise ParameterError(f"{key}.region", f"must be a region name, got {spec['region']!r}")
         out.append({**spec, "fix": fix})
     return out
 
 
-def select(part, specs, section: str = "modal") -> list[Support]:
-    """Supports from scene tables ``{box = [...], fix = ...}`` / ``{region = ..., fix = ...}``.
+def validate_specs(specs, section: str = "modal") -> list[dict]:
+    """:func:`check_specs` for a scene section: the error names ``<section>.supports[i].<key>``.
 
     Raises
     ------
     SceneError
-        Unknown region, a box holding no node, a radial support on a non-cylindrical region, or a
-        malformed table; the message names ``<section>.supports[i]``.
     """
-    specs = validate_specs(specs, section)
-    points = np.asarray(part.mesh.points, float)[:, :3]
+    with scene_keys(section):
+        return check_specs(specs)
+
+
+def select_supports(part, specs, label: str = "supports") -> list[Support]:
+    """Supports on ``part`` from :class:`Support` objects and/or tables.
+
+    Parameters
+    ----------
+    part : Part
+    specs : list
+        Each a :class:`Support` (kept as it is) or a table ``{"region": name, "fix": "xyz"}`` /
+        ``{"box": [xmin, xmax, ymin, ymax, zmin, zmax], "fix": "x"}`` (m; ``fix`` defaults to
+        ``"xyz"``; ``"radial"`` needs a cylindrical region).
+    label : str
+        Prefix of the tables' support labels: ``<label>[i] (region name)``.
+
+    Raises
+    ------
+    ParameterError
+        Unknown region, a box holding no node, a radial support on a non-cylindrical region, a
+        malformed table, or a Support whose nodes are not points of the part; the argument is
+        ``supports[i]...``.
+    """
+    specs = check_specs(specs)
+    n_points = len(part.mesh.points)
     out = []
     for i, spec in enumerate(specs):
-        key = f"{section}.supports[{i}]"
-        fix = spec["fix"]
-        cyl = None
-        if "region" in spec:
-            name = spec["region"]
-            if name not in part.regions:
-                known = ", ".join(sorted(part.regions)) or "none"
-                raise SceneError(f"{key}.region: no region {name!r} in part {part.name!r}; "
-                                 f"regions: {known}")
-            reg = part.regions[name]
-            nodes = np.asarray(reg.nodes, np.int64)
-            label = f"{key} (region {name})"
-            if fix == "radial":
-                cyl = region_cylinder(reg, name, points, f"{key}.fix: 'radial'")
+        key = f"supports[{i}]"
+        if isinstance(spec, Support):
+            nodes = np.asarray(spec.nodes)
+            if nodes.size and (nodes.min() < 0 or nodes.max() >= n_points):
+                raise ParameterError(f"{key}.nodes", f"point indices must lie in [0, {n_points}) "
+                                                     f"(a Support made for another part?)")
+            out.append(spec)
+        elif "region" in spec:
+            out.append(_region_support(part, spec["region"], spec["fix"], key,
+                                       f"{label}[{i}] (region {spec['region']})"))
         else:
-            box = spec["box"]
-            lo, hi = np.array(box[0::2], float), np.array(box[1::2], float)
-            inside = np.all((points >= lo) & (points <= hi), axis=1)
-            nodes = np.flatnonzero(inside)
-            label = f"{key} (box)"
-        if len(nodes) == 0:
-            ext = np.column_stack([points.min(0), points.max(0)]).ravel()
-            raise SceneError(f"{key}: selects no node (part bounding box "
-                             f"[{', '.join(f'{v:.4g}' for v in ext)}] m)")
-        out.append(Support(label=label, nodes=nodes, fix=fix, cylinder=cyl))
+            out.append(_box_support(part, spec["box"], spec["fix"], key, f"{label}[{i}] (box)"))
     return out
+
+
+def select(part, specs, section: str = "modal") -> list[Support]:
+    """:func:`select_supports` for the tables of a scene section (the stages' form).
+
+    Labels read ``<section>.supports[i] (region name)``.
+
+    Raises
+    ------
+    SceneError
+        Naming ``<section>.supports[i]...``.
+    """
+    with scene_keys(section):
+        return select_supports(part, specs, f"{section}.supports")
 
 
 def reduction(points: np.ndarray, used: np.ndarray, supports: list[Support]) -> sp.csr_matrix:
