@@ -46,7 +46,7 @@ class Support:
         Point indices.
     fix : str
         ``"x"``, ``"yz"``, ``"xyz"``, ... or ``"radial"``.
-    cylinder : Cylinder or None
+    cylinder : CylindricalSurface or None
         Axis of a radial support.
     """
 
@@ -175,10 +175,10 @@ def _require_nodes(part, nodes, argument):
 def fit_cylinder(points: np.ndarray, facets: np.ndarray):
     """Least-squares cylinder through a region's nodes (axis from the facet normals).
 
-    Returns a :class:`~crankmodal.part.Cylinder`; raises ``ValueError`` if the region is flat or
-    not cylindrical to 1 % of its radius.
+    Returns a :class:`~crankmodal.part.CylindricalSurface`; raises ``ValueError`` if the region
+    is flat or not cylindrical to 1 % of its radius.
     """
-    from ..part import Cylinder
+    from ..part import CylindricalSurface
 
     p = points[facets]
     n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
@@ -199,7 +199,8 @@ def fit_cylinder(points: np.ndarray, facets: np.ndarray):
     if not np.isfinite(radius) or err > 0.01 * radius:
         raise ValueError(f"not cylindrical (deviation {err:.3g} m from radius {radius:.3g} m)")
     centre = cu * e1 + cv * e2 + axis * 0.5 * (s.min() + s.max())
-    return Cylinder(centre=centre, axis=axis, radius=float(radius), length=float(np.ptp(s)))
+    return CylindricalSurface(centre=centre, axis=axis, radius=float(radius),
+                              length=float(np.ptp(s)))
 
 
 def region_cylinder(region, name: str, points: np.ndarray, argument: str, what: str = ""):
