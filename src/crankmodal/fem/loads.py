@@ -325,7 +325,7 @@ class Load:
     __radd__ = __add__
 
     def __mul__(self, factor: float) -> Load:
-        if isinstance(factor, bool) or not isinstance(factor, (int, float)):
+        if isinstance(factor, bool) or not isinstance(factor, (int, float, np.number)):
             return NotImplemented
         return Load(factor * np.asarray(self.vector), f"{factor:.4g} × {self.label}", self.points)
 
