@@ -51,7 +51,7 @@ from .supports import Support, reduce_matrix, reduction
 
 __all__ = [
     "COMPLETENESS_STEPS", "DENSE_FRACTION", "DENSE_LIMIT_DOF", "DENSE_MAX_DOF", "LANCZOS_TOL",
-    "MAX_RESCUES", "RIGID_RATIO", "RIGID_REF_MODES", "Lanczos", "Modes", "NumericalError",
+    "MAX_RESCUES", "RIGID_RATIO", "RIGID_REF_MODES", "Lanczos", "Modes",
     "allowed_rigid_modes", "check_pairs", "complete_modes", "default_shift", "deflated",
     "dense_bytes", "dense_pairs", "dense_with_rigid", "expected_rigid_modes", "lanczos",
     "lanczos_pairs", "pair_residuals", "refine_pairs", "rigid_mask", "rigid_pairs",

@@ -58,9 +58,10 @@ class Modes:
         Unconstrained degrees of freedom solved for.
     backend : str
         The sparse factorisation of the Lanczos run (``pardiso``, ``superlu``), or ``dense``
-        when the pencil was solved dense (:func:`use_dense`).
+        when the pencil was solved dense (:func:`~crankmodal.fem.dense_eigen.use_dense`).
     eigensolver : str
-        ``lanczos`` (shift-invert, sparse) or ``dense`` (LAPACK, :func:`dense_pairs`).
+        ``lanczos`` (shift-invert, sparse) or ``dense`` (LAPACK,
+        :func:`~crankmodal.fem.dense_eigen.dense_pairs`).
     timings : dict
         Wall time per phase, s.
     n_solves, solve_time : int, float
