@@ -129,3 +129,80 @@ def test_what_has_no_compiled_form_stays_on_the_python_path():
     assert Multibody([journal], [], [joint()], compiled=False).kernel() is None
     assert Multibody([journal], [], [joint(clearance_major=2e-4)]).kernel() is None  # worn bore
     assert Multibody([journal], [], [joint(viscosity=0.02, bearing_length=0.02)]).kernel() is None
+
+
+def _synthetic_flexible(name, k, frames, rng, mass=1.5, j0=4e-3, tilt=0):
+    """A FlexibleBody with random but admissible invariants (no FE): G symmetric positive
+    definite, S antisymmetric, interface maps random; ``tilt`` stiffness-free coordinates."""
+    from crankmodal.dynamics.flexible import FlexibleBody
+
+    X = rng.normal(size=(k, k)) * 0.1
+    G = np.eye(k) * 0.8 + X @ X.T * 0.1
+    S = rng.normal(size=(k, k)) * 0.05
+    S = S - S.T
+    f = np.concatenate([np.sort(rng.uniform(300.0, 9000.0, k - tilt)), np.zeros(tilt)])
+    itf = {nm: (np.array([x, y, 0.0]), rng.normal(size=(6, k)) * 0.05)
+           for nm, (x, y) in frames.items()}
+    return FlexibleBody(name, mass, j0, (0.0, 0.0), f, G, rng.normal(size=k) * 0.01, S, itf,
+                        damping_ratio=0.03, c=rng.normal(size=k) * 1e-3, n_tilt=tilt)
+
+
+def _flexible_train(seed=3, clearance=True):
+    rng = np.random.default_rng(seed)
+    cyls = [Cylinder(axis_angle=a, rod_length=0.14, rod_mass=0.9, rod_inertia=3.1e-3,
+                     rod_com=0.042, piston_mass=0.75, ring_friction=30.0,
+                     gas_force=lambda x: 2000 + 1500 * np.cos(x)) for a in (0.0, 1.2)]
+    crank = _synthetic_flexible("crank", 7, {"main_a": (0.0, 0.0), "pin": (0.035, 0.0)}, rng,
+                                mass=2.0, j0=0.01, tilt=2)
+    rods = [_synthetic_flexible(f"rod_{i}", 5, {"big": (-0.042, 0.0), "small": (0.098, 0.0)},
+                                rng, mass=0.9, j0=3.1e-3) for i in (1, 2)]
+    kw = {"law": "impact", "law_params": PARAMS, "friction": "coulomb",
+          "friction_params": FRICTION}
+    cl = {"big_end_1": {"clearance": 1e-4, "journal_radius": 0.02}} if clearance else None
+    return crank_train(0.035, cyls, 3000.0, crank_body=crank,
+                       crank_roles={"mains": ["main_a"], "pins": ["pin", "pin"],
+                                    "drive": "main_a"},
+                       rod_bodies=rods, clearances=cl, contact_kw=kw, gravity=(0.0, -9.81))
+
+
+def test_flexible_bodies_compiled_equal_the_python_path_state_by_state():
+    """A flexible crank (5 modes + 2 tilts) and two flexible rods (5 modes), a clearance at the
+    first big end (a flexible interface), gas and ring friction: the compiled kernel (full KKT
+    with M(ξ)) against FlexibleBody's own methods joint by joint, at random states in and out of
+    contact."""
+    mech = _flexible_train()
+    sysm = mech.system
+    assert sysm.kernel() is not None and sysm.kernel()._size == sysm.n + sysm.m
+    n = sysm.n
+    rng = np.random.default_rng(11)
+    in_contact = 0
+    for _ in range(10):
+        q = mech.q0 + rng.normal(0.0, 1.5e-4, n)
+        qd = mech.qd0 + rng.normal(0.0, 0.3, n)
+        t = rng.uniform(0.0, 0.05)
+        y = np.concatenate([q, qd, np.zeros(6)])
+        vimp = np.array([rng.uniform(0.01, 2.0)])
+        py, co = _both(sysm, sysm.rhs, t, y, vimp)
+        assert py[2 * n + 5] > 0.0  # modal damping power counted
+        for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
+            np.testing.assert_allclose(co[blk], py[blk], rtol=0,
+                                       atol=1e-10 * np.max(np.abs(py[blk])) + 1e-300)
+        sp, sc = _both(sysm, sysm.solve, t, q, qd, vimp)
+        np.testing.assert_allclose(sc["lam"], sp["lam"], rtol=0,
+                                   atol=1e-10 * np.max(np.abs(sp["lam"])))
+        np.testing.assert_allclose(sc["Cq"], sp["Cq"], rtol=0, atol=1e-15)
+        np.testing.assert_allclose(sc["phi"], sp["phi"], rtol=0, atol=1e-16)
+        kp, kc = sp["contacts"][0], sc["contacts"][0]
+        for key in ("delta", "delta_dot", "v_slip", "fn", "ft", "p_damp", "p_fric"):
+            assert kc[key] == pytest.approx(kp[key], rel=1e-11, abs=1e-12), key
+        for key in ("force", "Jj", "Jb"):
+            np.testing.assert_allclose(kc[key], kp[key], rtol=1e-11, atol=1e-15)
+        assert sysm.gap(0, q) == pytest.approx(sysm.clearances[0].gap(sysm, q), rel=1e-12)
+        in_contact += kp["fn"] > 0.0
+    assert in_contact >= 3
+
+
+def test_the_kernel_integrates_every_power_the_system_names():
+    from crankmodal.dynamics import compiled, system
+
+    assert compiled.N_AUX == system.N_AUX == len(system.AUX_NAMES)

@@ -1,20 +1,23 @@
-"""The right-hand side of an all-rigid system compiled with Numba.
+"""The right-hand side of a planar multibody system compiled with Numba.
 
-For a system of rigid bodies joined by pins, sliders and angle drives, with round dry clearance
-joints (any law of :mod:`.laws`), piston loads (gas force and ring friction) and crank torques,
-:class:`CompiledSystem` evaluates what :meth:`Multibody.solve` and :meth:`Multibody.rhs` evaluate
-in two Numba-compiled calls (``cache=True``: compiled once per machine, ~10-20 s, then loaded in
-~0.6 s) around NumPy's LAPACK solve: :func:`assemble` (frame table, applied and contact forces,
-constraint terms, and the KKT system reduced by the diagonal rigid-body mass matrix to the
-multipliers and the massless coordinates) and :func:`finish` (accelerations, multipliers,
-powers). The Python path costs ~0.25 ms per evaluation in some hundred small NumPy calls; this
-one ~0.02 ms (four-star with one clearance joint).
+For a system of rigid and planar flexible (floating-frame, modal) bodies joined by pins, sliders
+and angle drives, with round dry clearance joints (any law of :mod:`.laws`), piston loads (gas
+force and ring friction) and crank torques, :class:`CompiledSystem` evaluates what
+:meth:`Multibody.solve` and :meth:`Multibody.rhs` evaluate in two Numba-compiled calls
+(``cache=True``: compiled once per machine, ~20 s, then loaded in ~1 s) around LAPACK's solve:
+:func:`assemble` (frame table, flexible-body terms, applied and contact forces, constraint terms
+and the linear system) and :func:`finish` (accelerations, multipliers, powers). An all-rigid
+system's diagonal mass matrix is eliminated first (the system left is the multipliers' and the
+massless coordinates'); with a flexible body, whose ``M(ξ)`` is full in its (θ, ξ) block, the
+whole KKT system is solved. The Python path costs ~0.25 ms (rigid four-star with one clearance
+joint) to ~1 ms (flexible) per evaluation in some hundred small NumPy calls; this one ~0.02 ms
+(rigid) to ~0.05 ms (flexible crank with 20 modes and rod with 14).
 
-The formulas are those of :mod:`.system`, :mod:`.fastpath`, :mod:`.clearance`, :mod:`.contact`
-and :mod:`.loads`, written out per scalar; the results agree to round-off (the tests compare
-both paths state by state). The system is read once, when the compiled form is built: changing
-a joint's parameters afterwards is not seen. The impact velocities of restitution laws are
-the integrator's state, passed at every call.
+The formulas are those of :mod:`.system`, :mod:`.fastpath`, :mod:`.flexible`, :mod:`.clearance`,
+:mod:`.contact` and :mod:`.loads`, written out per scalar; the results agree to round-off (the
+tests compare both paths state by state). The system is read once, when the compiled form is
+built: changing a joint's parameters afterwards is not seen. The impact velocities of
+restitution laws are the integrator's state, passed at every call.
 """
 
 from __future__ import annotations
@@ -25,6 +28,8 @@ from scipy.linalg.lapack import dgesv as _gesv
 
 from .bodies import Ground, RigidBody
 from .clearance import ClearanceJoint
+from .flexible import FlexibleBody
+from .joints import AngleDrive, Prismatic, Revolute
 from .loads import CrankTorque, PistonLoads
 
 #: per clearance joint diagnostics written by the kernel (columns of ``diag``)
@@ -32,25 +37,28 @@ DIAG = ("ex", "ey", "nx", "ny", "d", "delta", "delta_dot", "v_slip", "fn", "ft",
         "v_elastic", "p_damp", "p_fric", "fel", "vrx", "vry", "omega_sum")
 _D = {k: i for i, k in enumerate(DIAG)}
 _S_CAP = 3.0
+_BODIES = (RigidBody, FlexibleBody)
+#: the powers the kernel integrates: system.AUX_NAMES (drive, loads, ideal joints, contact
+#: damping, friction, modal damping); not imported from .system, which imports this module
+N_AUX = 6
 
 
 def applicable(sysm) -> bool:
     """True when every part of ``sysm`` has a compiled form (see the module docstring)."""
-    from . import fastpath
-
-    if sysm._table is None or not fastpath.applicable(sysm):
+    if not all(type(b) in _BODIES for b in sysm.bodies):
+        return False
+    if not all(type(c) in (Revolute, Prismatic, AngleDrive) for c in sysm.constraints):
         return False
     for cj in sysm.clearances:
         if type(cj) is not ClearanceJoint or cj.clearance_major is not None \
                 or cj.viscosity is not None:
             return False
-        if not all(isinstance(b, (RigidBody, Ground)) for b in (cj.journal, cj.bearing)):
+        if not all(isinstance(b, (*_BODIES, Ground)) for b in (cj.journal, cj.bearing)):
             return False
     for ld in sysm.loads:
         if type(ld) not in (PistonLoads, CrankTorque):
             return False
-        if not isinstance(getattr(ld, "piston", ld.crank), RigidBody) \
-                or not isinstance(ld.crank, RigidBody):
+        if not all(isinstance(b, _BODIES) for b in (getattr(ld, "piston", ld.crank), ld.crank)):
             return False
     return True
 
@@ -149,44 +157,83 @@ def friction_coefficient(code, p, v):
 
 
 # ---------------------------------------------------------------------------------- the kernel
+# A frame ``k`` of the table belongs to a body whose coordinates start at column ``fcol[k]``
+# (-1: the ground, ``floc[k]`` then holds its global pose); ``floc[k]`` is its undeformed offset
+# (x, y, angle) in the body frame. A frame of a flexible body has ``fmn[k]`` modal columns after
+# the body's (x, y, θ), and ``fmodal[fmoff[k]:]`` holds its D (2 rows) and r_z (one row), each
+# ``fmn[k]`` long; the kernel writes ``A(θ) D`` to ``AD[fadoff[k]:]`` (x row, then y row).
 @njit(cache=True)
-def _frames(q, qd, fi, floc, gpose, pose, arm, bias, vel):
-    kr = fi.size
-    for k in range(kr):
-        i = fi[k]
+def _frames(q, qd, fr, pose, arm, bias, vel):
+    fcol, floc, fmn, fmoff, fadoff, fmodal, AD = fr
+    for k in range(fcol.size):
+        i = fcol[k]
+        if i < 0:
+            for j in range(3):
+                pose[k, j] = floc[k, j]
+                bias[k, j] = 0.0
+                vel[k, j] = 0.0
+            arm[k, 0] = 0.0
+            arm[k, 1] = 0.0
+            continue
         th = q[i + 2]
+        w = qd[i + 2]
         c, s = np.cos(th), np.sin(th)
-        ax = c * floc[k, 0] - s * floc[k, 1]
-        ay = s * floc[k, 0] + c * floc[k, 1]
+        sx, sy, ang = floc[k, 0], floc[k, 1], floc[k, 2]
+        vx = vy = wz = 0.0
+        nk = fmn[k]
+        if nk > 0:  # s = s0 + D ξ, angle + r_zᵀξ; A D ξ̇ and r_zᵀ ξ̇
+            o, a0, m0 = fmoff[k], fadoff[k], i + 3
+            for a in range(nk):
+                xi, xd = q[m0 + a], qd[m0 + a]
+                dx, dy, rz = fmodal[o + a], fmodal[o + nk + a], fmodal[o + 2 * nk + a]
+                sx += dx * xi
+                sy += dy * xi
+                ang += rz * xi
+                adx = c * dx - s * dy
+                ady = s * dx + c * dy
+                AD[a0 + a] = adx
+                AD[a0 + nk + a] = ady
+                vx += adx * xd
+                vy += ady * xd
+                wz += rz * xd
+        ax = c * sx - s * sy
+        ay = s * sx + c * sy
         pose[k, 0] = q[i] + ax
         pose[k, 1] = q[i + 1] + ay
-        pose[k, 2] = th + floc[k, 2]
+        pose[k, 2] = th + ang
         arm[k, 0] = ax
         arm[k, 1] = ay
-        w = qd[i + 2]
-        bias[k, 0] = -w * w * ax
-        bias[k, 1] = -w * w * ay
+        bias[k, 0] = -w * w * ax - 2.0 * w * vy
+        bias[k, 1] = -w * w * ay + 2.0 * w * vx
         bias[k, 2] = 0.0
-        vel[k, 0] = qd[i] - ay * w
-        vel[k, 1] = qd[i + 1] + ax * w
-        vel[k, 2] = w
-    for g in range(gpose.shape[0]):
-        k = kr + g
-        for j in range(3):
-            pose[k, j] = gpose[g, j]
-            bias[k, j] = 0.0
-            vel[k, j] = 0.0
-        arm[k, 0] = 0.0
-        arm[k, 1] = 0.0
+        vel[k, 0] = qd[i] - ay * w + vx
+        vel[k, 1] = qd[i + 1] + ax * w + vy
+        vel[k, 2] = w + wz
 
 
 @njit(cache=True)
-def _add_force(Q, fcol, arm, k, fx, fy, mz):
+def _jrow(out, r, k, s, cx, cy, ct, fr, arm):
+    """Add ``s (cx, cy, ct) · J_k`` (frame ``k``'s Jacobian rows combined) to row ``r`` of
+    ``out``; with ``out`` a column (``r`` = 0 of a (1, n) view) it adds ``J_kᵀ f``."""
+    fcol, _floc, fmn, fmoff, fadoff, fmodal, AD = fr
     i = fcol[k]
-    if i >= 0:
-        Q[i] += fx
-        Q[i + 1] += fy
-        Q[i + 2] += -arm[k, 1] * fx + arm[k, 0] * fy + mz
+    if i < 0:
+        return
+    out[r, i] += s * cx
+    out[r, i + 1] += s * cy
+    out[r, i + 2] += s * (-cx * arm[k, 1] + cy * arm[k, 0] + ct)
+    nk = fmn[k]
+    if nk > 0:
+        o, a0, m0 = fmoff[k], fadoff[k], i + 3
+        for a in range(nk):
+            out[r, m0 + a] += s * (cx * AD[a0 + a] + cy * AD[a0 + nk + a]
+                                   + ct * fmodal[o + 2 * nk + a])
+
+
+@njit(cache=True)
+def _add_force(Q2, fr, arm, k, fx, fy, mz):
+    """``Q += J_kᵀ (fx, fy, mz)``: a force and moment at frame ``k`` (``Q2``: Q as (1, n))."""
+    _jrow(Q2, 0, k, 1.0, fx, fy, mz, fr, arm)
 
 
 @njit(cache=True)
@@ -211,14 +258,56 @@ def _clearance(j, pose, vel, cl_int, cl_f, out):
     out[18] = vel[kj, 2] + vel[kb, 2]
 
 
-#: order of the integer tables packed into ``I`` (see :meth:`CompiledSystem._pack`)
-INT_TABLES = ("fi", "fcol", "rev_rows", "rev_a", "rev_b", "side_rows", "side_k", "side_col",
-              "pri_rows", "pri_k", "pri_col", "drive_rows", "drive_k", "cl_int", "pl_int",
-              "gas_off", "tq_k", "is_drive", "col_ptr", "col_rows", "massless")
+@njit(cache=True)
+def _flexible(q, qd, fb_int, fb_f, Q, A):
+    """Each flexible body's quadratic velocity, elastic and modal damping forces into ``Q`` and
+    its mass block ``M(ξ)`` (the θ, ξ rows and columns) into ``A``, as
+    :class:`~.flexible.FlexibleBody` computes them; returns the modal damping power, W."""
+    p_modal = 0.0
+    for bi in range(fb_int.shape[0]):
+        c0, k, o = fb_int[bi, 0], fb_int[bi, 1], fb_int[bi, 2]
+        j0 = fb_f[o + 1]
+        ob, oc, oG = o + 2, o + 2 + k, o + 2 + 2 * k
+        oS, oK = oG + k * k, oG + 2 * k * k
+        oC = oK + k
+        t, m0 = c0 + 2, c0 + 3
+        w = qd[t]
+        cv = np.empty(k)
+        mtt = j0
+        q_th = 0.0
+        for a in range(k):
+            g = fb_f[ob + a]
+            for b in range(k):
+                g += fb_f[oG + a * k + b] * q[m0 + b]
+            cv[a] = g  # b + G ξ
+            mtt += (fb_f[ob + a] + g) * q[m0 + a]  # J0 + 2bᵀξ + ξᵀGξ
+            q_th += g * qd[m0 + a]
+        Q[t] += -2.0 * w * q_th
+        A[t, t] = mtt
+        for a in range(k):
+            sx = 0.0
+            h = fb_f[oc + a]
+            for b in range(k):
+                sx += fb_f[oS + a * k + b] * qd[m0 + b]
+                h += fb_f[oS + b * k + a] * q[m0 + b]  # c + Sᵀξ
+                A[m0 + a, m0 + b] = fb_f[oG + a * k + b]
+            A[t, m0 + a] = h
+            A[m0 + a, t] = h
+            xd = qd[m0 + a]
+            Q[m0 + a] += (w * w * cv[a] + 2.0 * w * sx - fb_f[oK + a] * q[m0 + a]
+                          - fb_f[oC + a] * xd)
+            p_modal += fb_f[oC + a] * xd * xd
+    return p_modal
+
+
+#: order of the integer tables packed into ``I`` (see :class:`CompiledSystem`)
+INT_TABLES = ("fcol", "fmn", "fmoff", "fadoff", "rev_rows", "rev_a", "rev_b", "pri_rows",
+              "pri_k", "drive_rows", "drive_k", "cl_int", "pl_int", "gas_off", "tq_k",
+              "is_drive", "col_ptr", "col_rows", "massless", "fb_int", "full")
 #: order of the float tables packed into ``F``
-FLOAT_TABLES = ("floc", "gpose", "mdiag", "Q0", "Cq0", "side_sign", "pri_n", "pri_o", "pri_ang",
-                "cl_f", "law_vec", "fric_vec", "pl_f", "gas_x", "gas_f", "gas_period", "tq_val",
-                "baumgarte")
+FLOAT_TABLES = ("floc", "fmodal", "mdiag", "Q0", "pri_n", "pri_o", "pri_ang", "cl_f", "law_vec",
+                "fric_vec", "pl_f", "gas_x", "gas_f", "gas_period", "tq_val", "baumgarte",
+                "fb_f")
 
 
 @njit(cache=True)
@@ -227,11 +316,22 @@ def _seg(a, o, i):
 
 
 @njit(cache=True)
+def _frame_tables(I, io, F, fo):
+    fcol, fmn, fmoff, fadoff = _seg(I, io, 0), _seg(I, io, 1), _seg(I, io, 2), _seg(I, io, 3)
+    floc, fmodal = _seg(F, fo, 0).reshape((-1, 3)), _seg(F, fo, 1)
+    n_ad = 0
+    for k in range(fcol.size):
+        n_ad += 2 * fmn[k]
+    return fcol, floc, fmn, fmoff, fadoff, fmodal, np.empty(n_ad)
+
+
+@njit(cache=True)
 def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q, cqd, A, rhs):
-    """Everything up to the linear solve: the applied and contact forces ``Q``, constraint values
-    ``phi`` and Jacobian ``Cq``, ``cqd = Cq qd``, clearance diagnostics ``diag`` (rows of
-    :data:`DIAG`), ``powers[1:]`` = (loads, -, contact damping, friction) and the reduced system
-    ``A x = rhs`` (see the comment below; :func:`finish` takes its solution), written in place.
+    """Everything up to the linear solve: the applied, contact and flexible-body forces ``Q``,
+    constraint values ``phi`` and Jacobian ``Cq``, ``cqd = Cq qd``, clearance diagnostics
+    ``diag`` (rows of :data:`DIAG`), ``powers[1:]`` = (loads, -, contact damping, friction,
+    modal damping) and the linear system ``A x = rhs`` (see the comments below; :func:`finish`
+    takes its solution), written in place.
 
     ``dv``: per drive (angle, speed, acceleration) at ``t``; ``vimp``: per clearance joint its
     impact velocity; ``gas_py``: gas forces of pistons without a table; ``I, io, F, fo``: the
@@ -239,29 +339,31 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
     """
     n = q.size
     m = phi.size
-    fi, fcol = _seg(I, io, 0), _seg(I, io, 1)
-    rev_rows, rev_a, rev_b = _seg(I, io, 2), _seg(I, io, 3), _seg(I, io, 4)
-    side_rows, side_k, side_col = _seg(I, io, 5), _seg(I, io, 6), _seg(I, io, 7)
-    pri_rows, pri_k, pri_col = _seg(I, io, 8), _seg(I, io, 9), _seg(I, io, 10)
-    drive_rows, drive_k = _seg(I, io, 11), _seg(I, io, 12)
-    cl_int, pl_int = _seg(I, io, 13).reshape((-1, 4)), _seg(I, io, 14).reshape((-1, 3))
-    gas_off, tq_k = _seg(I, io, 15), _seg(I, io, 16)
-    col_ptr, col_rows, massless = _seg(I, io, 18), _seg(I, io, 19), _seg(I, io, 20)
-    floc, gpose = _seg(F, fo, 0).reshape((-1, 3)), _seg(F, fo, 1).reshape((-1, 3))
-    mdiag, Q0, Cq0 = _seg(F, fo, 2), _seg(F, fo, 3), _seg(F, fo, 4).reshape((m, n))
-    side_sign, pri_n = _seg(F, fo, 5), _seg(F, fo, 6).reshape((-1, 2))
-    pri_o, pri_ang = _seg(F, fo, 7).reshape((-1, 2)), _seg(F, fo, 8)
-    cl_f, law_vec = _seg(F, fo, 9).reshape((-1, 3)), _seg(F, fo, 10).reshape((-1, 5))
-    fric_vec, pl_f = _seg(F, fo, 11).reshape((-1, 4)), _seg(F, fo, 12).reshape((-1, 6))
-    gas_x, gas_f, gas_period = _seg(F, fo, 13), _seg(F, fo, 14), _seg(F, fo, 15)
-    tq_val, baumgarte = _seg(F, fo, 16), F[fo[17]]
-    K = fcol.size
+    fr = _frame_tables(I, io, F, fo)
+    rev_rows, rev_a, rev_b = _seg(I, io, 4), _seg(I, io, 5), _seg(I, io, 6)
+    pri_rows, pri_k = _seg(I, io, 7), _seg(I, io, 8)
+    drive_rows, drive_k = _seg(I, io, 9), _seg(I, io, 10)
+    cl_int, pl_int = _seg(I, io, 11).reshape((-1, 4)), _seg(I, io, 12).reshape((-1, 3))
+    gas_off, tq_k = _seg(I, io, 13), _seg(I, io, 14)
+    col_ptr, col_rows, massless = _seg(I, io, 16), _seg(I, io, 17), _seg(I, io, 18)
+    fb_int, full = _seg(I, io, 19).reshape((-1, 3)), _seg(I, io, 20)[0]
+    mdiag, Q0 = _seg(F, fo, 2), _seg(F, fo, 3)
+    pri_n, pri_o = _seg(F, fo, 4).reshape((-1, 2)), _seg(F, fo, 5).reshape((-1, 2))
+    pri_ang = _seg(F, fo, 6)
+    cl_f, law_vec = _seg(F, fo, 7).reshape((-1, 3)), _seg(F, fo, 8).reshape((-1, 5))
+    fric_vec, pl_f = _seg(F, fo, 9).reshape((-1, 4)), _seg(F, fo, 10).reshape((-1, 6))
+    gas_x, gas_f, gas_period = _seg(F, fo, 11), _seg(F, fo, 12), _seg(F, fo, 13)
+    tq_val, baumgarte, fb_f = _seg(F, fo, 14), F[fo[15]], _seg(F, fo, 16)
+    K = fr[0].size
     pose = np.empty((K, 3))
     arm = np.empty((K, 2))
     bias = np.empty((K, 3))
     vel = np.empty((K, 3))
-    _frames(q, qd, fi, floc, gpose, pose, arm, bias, vel)
+    _frames(q, qd, fr, pose, arm, bias, vel)
     Q[:] = Q0
+    Q2 = Q.reshape((1, n))
+    A[:, :] = 0.0
+    powers[5] = _flexible(q, qd, fb_int, fb_f, Q, A)
     # clearance joints (clearance.ClearanceJoint.forces, round dry bore)
     p_damp = 0.0
     p_fric = 0.0
@@ -281,8 +383,8 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
         fy = -fn * ny + ft * nx
         if fn != 0.0:
             rj, c = cl_f[j, 1], cl_f[j, 0]
-            _add_force(Q, fcol, arm, cl_int[j, 0], fx, fy, rj * ft)
-            _add_force(Q, fcol, arm, cl_int[j, 1], -fx, -fy, -(rj + c) * ft)
+            _add_force(Q2, fr, arm, cl_int[j, 0], fx, fy, rj * ft)
+            _add_force(Q2, fr, arm, cl_int[j, 1], -fx, -fy, -(rj + c) * ft)
         row[8], row[9], row[10], row[11] = fn, ft, fx, fy
         row[12] = elastic_energy(code, law_vec[j], delta) if delta > 0.0 else 0.0
         row[13] = (fn - fel) * ddot
@@ -306,51 +408,70 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
         if pl_f[i, 3] > 0.0:
             f -= pl_f[i, 3] * np.tanh(v / pl_f[i, 4])
         if f != 0.0:
-            _add_force(Q, fcol, arm, kp, f * a0, f * a1, 0.0)
+            _add_force(Q2, fr, arm, kp, f * a0, f * a1, 0.0)
         p_loads += f * v
     for i in range(tq_k.size):
-        _add_force(Q, fcol, arm, tq_k[i], 0.0, 0.0, tq_val[i])
+        _add_force(Q2, fr, arm, tq_k[i], 0.0, 0.0, tq_val[i])
         p_loads += tq_val[i] * vel[tq_k[i], 2]
-    # constraint terms (fastpath.RigidConstraintTable.terms)
+    # constraint terms (the joints' blocks: pins, sliders on a ground line, angle drives)
     nu = np.zeros(m)
     gamma = np.zeros(m)
-    Cq[:, :] = Cq0
+    Cq[:, :] = 0.0
     for r_i in range(rev_rows.size):
         r, a, b = rev_rows[r_i], rev_a[r_i], rev_b[r_i]
         phi[r] = pose[a, 0] - pose[b, 0]
         phi[r + 1] = pose[a, 1] - pose[b, 1]
         gamma[r] = -(bias[a, 0] - bias[b, 0])
         gamma[r + 1] = -(bias[a, 1] - bias[b, 1])
-    for s_i in range(side_rows.size):
-        r, k, s = side_rows[s_i], side_k[s_i], side_sign[s_i]
-        Cq[r, side_col[s_i]] = -s * arm[k, 1]
-        Cq[r + 1, side_col[s_i]] = s * arm[k, 0]
+        for k, s in ((a, 1.0), (b, -1.0)):
+            _jrow(Cq, r, k, s, 1.0, 0.0, 0.0, fr, arm)
+            _jrow(Cq, r + 1, k, s, 0.0, 1.0, 0.0, fr, arm)
     for p_i in range(pri_rows.size):
         r, k = pri_rows[p_i], pri_k[p_i]
         n0, n1 = pri_n[p_i, 0], pri_n[p_i, 1]
         phi[r] = n0 * (pose[k, 0] - pri_o[p_i, 0]) + n1 * (pose[k, 1] - pri_o[p_i, 1])
         phi[r + 1] = pose[k, 2] - pri_ang[p_i]
-        Cq[r, pri_col[p_i]] = -n0 * arm[k, 1] + n1 * arm[k, 0]
+        _jrow(Cq, r, k, 1.0, n0, n1, 0.0, fr, arm)
+        _jrow(Cq, r + 1, k, 1.0, 0.0, 0.0, 1.0, fr, arm)
         gamma[r] = -(n0 * bias[k, 0] + n1 * bias[k, 1])
     for d_i in range(drive_rows.size):
         r, k = drive_rows[d_i], drive_k[d_i]
         phi[r] = pose[k, 2] - dv[d_i, 0]
+        _jrow(Cq, r, k, 1.0, 0.0, 0.0, 1.0, fr, arm)
         nu[r] = dv[d_i, 1]
         gamma[r] = dv[d_i, 2]
-    # M qdd + Cq^T lam = Q, Cq qdd = gamma - 2 a phidot - a^2 phi = c with the diagonal M of
-    # rigid bodies: the massive coordinates (a) eliminated, qdd_a = M_a^-1 (Q_a - Cq_a^T lam),
-    # leaves for the massless ones (b, e.g. a piston's rotation) and lam
-    #   [ 0     Cq_b^T              ] [ qdd_b ]   [ Q_b                    ]
-    #   [ Cq_b  -Cq_a M_a^-1 Cq_a^T ] [ lam   ] = [ c - Cq_a M_a^-1 Q_a    ]
-    # summed over the few rows each column of Cq touches (col_ptr, col_rows: its pattern)
-    nb = massless.size
-    A[:, :] = 0.0
     for r in range(m):
         acc = 0.0
         for i in range(n):
             acc += Cq[r, i] * qd[i]
         cqd[r] = acc
-        rhs[nb + r] = gamma[r] - 2.0 * baumgarte * (acc - nu[r]) - baumgarte * baumgarte * phi[r]
+        gamma[r] = gamma[r] - 2.0 * baumgarte * (acc - nu[r]) - baumgarte * baumgarte * phi[r]
+    powers[1] = p_loads
+    powers[3] = p_damp
+    powers[4] = p_fric
+    if full:
+        # with flexible bodies, the whole KKT system (M(q) is not diagonal):
+        #   [ M   Cq^T ] [ qdd ]   [ Q ]
+        #   [ Cq  0    ] [ lam ] = [ c ],  c = gamma - 2 a phidot - a^2 phi
+        for i in range(n):
+            if mdiag[i] != 0.0:
+                A[i, i] = mdiag[i]
+            rhs[i] = Q[i]
+        for r in range(m):
+            rhs[n + r] = gamma[r]
+            for i in range(n):
+                A[n + r, i] = Cq[r, i]
+                A[i, n + r] = Cq[r, i]
+        return
+    # M qdd + Cq^T lam = Q, Cq qdd = c with the diagonal M of rigid bodies: the massive
+    # coordinates (a) eliminated, qdd_a = M_a^-1 (Q_a - Cq_a^T lam), leaves for the massless
+    # ones (b, e.g. a piston's rotation) and lam
+    #   [ 0     Cq_b^T              ] [ qdd_b ]   [ Q_b                    ]
+    #   [ Cq_b  -Cq_a M_a^-1 Cq_a^T ] [ lam   ] = [ c - Cq_a M_a^-1 Q_a    ]
+    # summed over the few rows each column of Cq touches (col_ptr, col_rows: its pattern)
+    nb = massless.size
+    for r in range(m):
+        rhs[nb + r] = gamma[r]
     for i in range(n):
         if mdiag[i] == 0.0:
             continue
@@ -370,9 +491,6 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
             r = col_rows[a_i]
             A[b_k, nb + r] = Cq[r, i]
             A[nb + r, b_k] = Cq[r, i]
-    powers[1] = p_loads
-    powers[3] = p_damp
-    powers[4] = p_fric
 
 
 @njit(cache=True)
@@ -381,19 +499,25 @@ def finish(sol, Q, Cq, cqd, I, io, F, fo, qdd, lam, powers):
     joints) from the solution ``sol`` of :func:`assemble`'s system. Returns False on a
     non-finite result."""
     n, m = qdd.size, lam.size
-    is_drive, col_ptr = _seg(I, io, 17), _seg(I, io, 18)
-    col_rows, massless = _seg(I, io, 19), _seg(I, io, 20)
+    is_drive, col_ptr = _seg(I, io, 15), _seg(I, io, 16)
+    col_rows, massless = _seg(I, io, 17), _seg(I, io, 18)
+    full = _seg(I, io, 20)[0]
     mdiag = _seg(F, fo, 2)
-    nb = massless.size
-    for b_k in range(nb):
-        qdd[massless[b_k]] = sol[b_k]
-    for i in range(n):
-        if mdiag[i] == 0.0:
-            continue
-        acc = Q[i]
-        for a_i in range(col_ptr[i], col_ptr[i + 1]):
-            acc -= Cq[col_rows[a_i], i] * sol[nb + col_rows[a_i]]
-        qdd[i] = acc / mdiag[i]
+    if full:
+        nb = n
+        for i in range(n):
+            qdd[i] = sol[i]
+    else:
+        nb = massless.size
+        for b_k in range(nb):
+            qdd[massless[b_k]] = sol[b_k]
+        for i in range(n):
+            if mdiag[i] == 0.0:
+                continue
+            acc = Q[i]
+            for a_i in range(col_ptr[i], col_ptr[i + 1]):
+                acc -= Cq[col_rows[a_i], i] * sol[nb + col_rows[a_i]]
+            qdd[i] = acc / mdiag[i]
     p_drive = 0.0
     p_all = 0.0
     for r in range(m):
@@ -404,7 +528,7 @@ def finish(sol, Q, Cq, cqd, I, io, F, fo, qdd, lam, powers):
             p_drive += p
     powers[0] = p_drive
     powers[2] = p_all - p_drive
-    ok = np.isfinite(p_all + powers[1] + powers[3] + powers[4])
+    ok = np.isfinite(p_all + powers[1] + powers[3] + powers[4] + powers[5])
     for i in range(n):
         ok = ok and np.isfinite(qdd[i])
     return ok
@@ -413,38 +537,78 @@ def finish(sol, Q, Cq, cqd, I, io, F, fo, qdd, lam, powers):
 @njit(cache=True)
 def clearance_kinematics(j, q, qd, I, io, F, fo, out):
     """Penetration (``out[5]``) and its rate (``out[6]``) of clearance joint ``j`` only."""
-    fi, fcol = _seg(I, io, 0), _seg(I, io, 1)
-    floc, gpose = _seg(F, fo, 0).reshape((-1, 3)), _seg(F, fo, 1).reshape((-1, 3))
-    cl_int, cl_f = _seg(I, io, 13).reshape((-1, 4)), _seg(F, fo, 9).reshape((-1, 3))
-    K = fcol.size
+    fr = _frame_tables(I, io, F, fo)
+    cl_int, cl_f = _seg(I, io, 11).reshape((-1, 4)), _seg(F, fo, 7).reshape((-1, 3))
+    K = fr[0].size
     pose = np.empty((K, 3))
     arm = np.empty((K, 2))
     bias = np.empty((K, 3))
     vel = np.empty((K, 3))
-    _frames(q, qd, fi, floc, gpose, pose, arm, bias, vel)
+    _frames(q, qd, fr, pose, arm, bias, vel)
     _clearance(j, pose, vel, cl_int, cl_f, out)
+
+
+def _frames_of(c):
+    if isinstance(c, Revolute):
+        return [(c.a, c.frame_a), (c.b, c.frame_b)]
+    return [(c.a, c.frame_a)]
 
 
 class CompiledSystem:
     """The tables of one :class:`~.system.Multibody` for :func:`assemble` and :func:`finish`."""
 
     def __init__(self, sysm):
-        tab = sysm._table
         self.sysm = sysm
-        self.n, self.m = sysm.n, sysm.m
-        index = dict(tab.index)
-        k_rigid = len(sysm._fi)
-        gpose = [np.asarray(p, float) for p in tab.ground_pose]
+        self.n, self.m = n, m = sysm.n, sysm.m
+        index = {}
+        fcol, floc, fmn, fmodal, fmoff, fadoff = [], [], [], [], [], []
+        self._frame_list = []
 
         def key(body, frame):
             kk = (id(body), frame)
             if kk not in index:
-                if not isinstance(body, Ground):
-                    raise KeyError(f"frame {frame!r} of {body.name!r} is not registered")
-                index[kk] = k_rigid + len(gpose)
-                gpose.append(body.frame_pose(None, frame))
+                index[kk] = len(fcol)
+                self._frame_list.append((body, frame))
+                nk = 0
+                if isinstance(body, Ground):
+                    fcol.append(-1)
+                    floc.append(body.frame_pose(None, frame))
+                elif isinstance(body, FlexibleBody):
+                    s0, D, rz = body.frames[frame]
+                    fcol.append(sysm.slices[id(body)].start)
+                    floc.append((s0[0], s0[1], 0.0))
+                    nk = body.n_modes
+                    fmodal.append(np.concatenate([np.ravel(D), np.ravel(rz)]))
+                else:
+                    s, ph = body.local(frame)
+                    fcol.append(sysm.slices[id(body)].start)
+                    floc.append((s[0], s[1], ph))
+                fmoff.append(sum(a.size for a in fmodal[:-1]) if nk else 0)
+                fadoff.append(2 * sum(fmn))
+                fmn.append(nk)
             return index[kk]
 
+        # constraints (the rows of each joint's blocks) and their sparsity pattern
+        rev_rows, rev_a, rev_b, pri_rows, pri_k, pri_n, pri_o, pri_ang = ([] for _ in range(8))
+        self.drives = []
+        row_frames = [[] for _ in range(m)]
+        for c, r in zip(sysm.constraints, sysm.rows):
+            r0 = r.start
+            ks = [key(b, f) for b, f in _frames_of(c)]
+            for rr in range(r.start, r.stop):
+                row_frames[rr] += ks
+            if isinstance(c, Revolute):
+                rev_rows.append(r0)
+                rev_a.append(ks[0])
+                rev_b.append(ks[1])
+            elif isinstance(c, Prismatic):
+                pri_rows.append(r0)
+                pri_k.append(ks[0])
+                pri_n.append((-c.axis[1], c.axis[0]))
+                pri_o.append(np.asarray(c.origin, float))
+                pri_ang.append(c.angle)
+            else:  # AngleDrive
+                self.drives.append((r0, ks[0], c.profile))
         cl_int, cl_f, law_vec, fric_vec = [], [], [], []
         for cj in sysm.clearances:
             cl_int.append((key(cj.journal, cj.journal_frame), key(cj.bearing, cj.bearing_frame),
@@ -481,58 +645,62 @@ class CompiledSystem:
             if type(ld) is CrankTorque:
                 tq_k.append(key(ld.crank, ld.frame))
                 tq_val.append(ld.torque)
-        fi = np.asarray(sysm._fi, np.int64)
-        mdiag = np.zeros(self.n)
-        Q0 = np.zeros(self.n)
+        # bodies: diagonal masses (rigid bodies; x, y of flexible ones), constant forces, and
+        # the flexible bodies' invariants
+        mdiag = np.zeros(n)
+        Q0 = np.zeros(n)
+        fb_int, fb_f = [], []
         for b in sysm.bodies:
             s = sysm.slices[id(b)]
-            M = b.mass_matrix(np.zeros(b.ndof))
-            if np.count_nonzero(M - np.diag(np.diag(M))):
-                raise ValueError("the compiled path needs diagonal rigid-body mass matrices")
-            mdiag[s] = np.diag(M)
-            Q0[s] = b.gravity_force(np.zeros(b.ndof), sysm.gravity) \
-                + b.velocity_forces(np.zeros(b.ndof), np.zeros(b.ndof))
-        # sparsity pattern of Cq by column: Cq0's entries and the rotation columns set per call
-        pattern = tab.Cq0 != 0.0
-        pattern[tab.side_rows, tab.side_col] = pattern[tab.side_rows + 1, tab.side_col] = True
-        pattern[tab.pri_rows, tab.pri_col] = True
-        col_rows = [np.flatnonzero(pattern[:, i]) for i in range(self.n)]
+            z = np.zeros(b.ndof)
+            Q0[s] = b.gravity_force(z, sysm.gravity)
+            if isinstance(b, FlexibleBody):
+                mdiag[s.start:s.start + 2] = b.mass
+                fb_int.append((s.start, b.n_modes, sum(a.size for a in fb_f)))
+                fb_f.append(np.concatenate([[b.mass, b.j0], b.b, b.c, np.ravel(b.G),
+                                            np.ravel(b.S), b.K, b.C]))
+            else:
+                Q0[s] += b.velocity_forces(z, z)
+                mdiag[s] = np.diag(b.mass_matrix(z))
+        full = bool(fb_int)
+        # sparsity pattern of Cq by column (the reduced system of an all-rigid one)
+        pattern = np.zeros((m, n), bool)
+        for r, ks in enumerate(row_frames):
+            for k in ks:
+                if fcol[k] >= 0:
+                    pattern[r, fcol[k]:fcol[k] + 3 + fmn[k]] = True
+        col_rows = [np.flatnonzero(pattern[:, i]) for i in range(n)]
         col_ptr = np.concatenate([[0], np.cumsum([len(r) for r in col_rows])])
         nc, npl = len(sysm.clearances), len(pl_int)
-        self.drives = tab.drives
         self.clearances = sysm.clearances
-        ints = {"fi": fi, "fcol": np.concatenate([fi, -np.ones(len(gpose), np.int64)]),
-                "rev_rows": tab.rev_rows, "rev_a": tab.rev_a, "rev_b": tab.rev_b,
-                "side_rows": tab.side_rows, "side_k": tab.side_k, "side_col": tab.side_col,
-                "pri_rows": tab.pri_rows, "pri_k": tab.pri_k, "pri_col": tab.pri_col,
-                "drive_rows": [d[0] for d in tab.drives], "drive_k": [d[1] for d in tab.drives],
+        massless = np.zeros(0, np.int64) if full else np.flatnonzero(mdiag == 0.0)
+        ints = {"fcol": fcol, "fmn": fmn, "fmoff": fmoff, "fadoff": fadoff,
+                "rev_rows": rev_rows, "rev_a": rev_a, "rev_b": rev_b,
+                "pri_rows": pri_rows, "pri_k": pri_k,
+                "drive_rows": [d[0] for d in self.drives],
+                "drive_k": [d[1] for d in self.drives],
                 "cl_int": cl_int, "pl_int": pl_int, "gas_off": off, "tq_k": tq_k,
                 "is_drive": sysm._drive_rows, "col_ptr": col_ptr,
                 "col_rows": np.concatenate(col_rows) if col_rows else [],
-                "massless": np.flatnonzero(mdiag == 0.0)}
-        floats = {"floc": sysm._floc, "gpose": gpose, "mdiag": mdiag, "Q0": Q0,
-                  "Cq0": tab.Cq0, "side_sign": tab.side_sign, "pri_n": tab.pri_n,
-                  "pri_o": tab.pri_o, "pri_ang": tab.pri_ang, "cl_f": cl_f, "law_vec": law_vec,
-                  "fric_vec": fric_vec, "pl_f": pl_f, "gas_x": gx, "gas_f": gf,
-                  "gas_period": period, "tq_val": tq_val, "baumgarte": [sysm.baumgarte]}
-        self.I, self.io = _pack([ints[k] for k in INT_TABLES], np.int64)
-        self.F, self.fo = _pack([floats[k] for k in FLOAT_TABLES], float)
+                "massless": massless, "fb_int": fb_int, "full": [int(full)]}
+        floats = {"floc": floc, "fmodal": fmodal, "mdiag": mdiag, "Q0": Q0,
+                  "pri_n": pri_n, "pri_o": pri_o, "pri_ang": pri_ang, "cl_f": cl_f,
+                  "law_vec": law_vec, "fric_vec": fric_vec, "pl_f": pl_f, "gas_x": gx,
+                  "gas_f": gf, "gas_period": period, "tq_val": tq_val,
+                  "baumgarte": [sysm.baumgarte], "fb_f": fb_f}
+        self.I, self.io = _pack([_flat(ints[k]) for k in INT_TABLES], np.int64)
+        self.F, self.fo = _pack([_flat(floats[k]) for k in FLOAT_TABLES], float)
         self.gas_py = np.zeros(npl)
         self.vimp = np.zeros(nc)
         self._diag = np.zeros((nc, len(DIAG)))
         self._kin = np.zeros(len(DIAG))
-        self._zeros = np.zeros(self.n)
+        self._zeros = np.zeros(n)
         # for solve's per-joint diagnostics
-        self._cl_frames = [(int(a[0]), int(a[1])) for a in
-                           self._table("cl_int").reshape(-1, 4)]
-        self._fcol = [int(i) for i in self._table("fcol")]
-        f = FLOAT_TABLES.index("floc")
-        self._floc = self.F[self.fo[f]:self.fo[f + 1]].reshape(-1, 3).copy()
-        self._scratch = (np.empty(self.m), np.empty(self.m), np.empty((self.m, self.n)),
-                         np.zeros(5))
-        nb = int(np.count_nonzero(mdiag == 0.0))
-        self._work = (np.empty(self.n), np.empty(self.m), np.zeros((nb + self.m, nb + self.m)),
-                      np.empty(nb + self.m))
+        self._cl_frames = [(int(a[0]), int(a[1])) for a in np.reshape(cl_int, (-1, 4))]
+        self._scratch = (np.empty(m), np.empty(m), np.empty((m, n)), np.zeros(N_AUX))
+        size = n + m if full else len(massless) + m
+        self._size = size  # of the linear system: n + m with a flexible body
+        self._work = (np.empty(n), np.empty(m), np.zeros((size, size)), np.empty(size))
 
     def _call(self, t, q, qd, qdd, lam, phi, Cq, diag, powers, v_impact=None):
         # one compiled specialisation: contiguous float arrays (a column of a history is not)
@@ -564,14 +732,14 @@ class CompiledSystem:
         return finish(sol, Q, Cq, cqd, self.I, self.io, self.F, self.fo, qdd, lam, powers)
 
     def rhs(self, t, y, v_impact=None):
-        """``dy`` of :meth:`Multibody.rhs` (its modal damping power 0); None if not finite."""
+        """``dy`` of :meth:`Multibody.rhs`; None if not finite."""
         n = self.n
         dy = np.zeros(y.size)
         q, qd = y[:n], y[n:2 * n]
         dy[:n] = qd
         lam, phi, Cq, powers = self._scratch
         ok = self._call(t, q, qd, dy[n:2 * n], lam, phi, Cq, self._diag, powers, v_impact)
-        dy[2 * n: 2 * n + 5] = powers
+        dy[2 * n: 2 * n + N_AUX] = powers
         return dy if ok else None
 
     def solve(self, t, q, qd, v_impact=None) -> dict:
@@ -579,7 +747,7 @@ class CompiledSystem:
         n, m = self.n, self.m
         qdd, lam, phi, Cq = np.empty(n), np.empty(m), np.empty(m), np.empty((m, n))
         diag = np.zeros_like(self._diag)
-        powers = np.zeros(5)
+        powers = np.zeros(N_AUX)
         self._call(t, q, qd, qdd, lam, phi, Cq, diag, powers, v_impact)
         nu = np.zeros(m)
         for r, _, prof in self.drives:
@@ -588,7 +756,7 @@ class CompiledSystem:
         for j, cj in enumerate(self.clearances):
             row = diag[j]
             nx, ny = row[_D["nx"]], row[_D["ny"]]
-            kj, kb = self._frames_of(j)
+            kj, kb = self._cl_frames[j]
             contacts.append({
                 "e": row[0:2].copy(), "n": np.array([nx, ny]), "t": np.array([-ny, nx]),
                 "grad": np.array([nx, ny]), "dtheta": 0.0, "delta": float(row[_D["delta"]]),
@@ -602,23 +770,12 @@ class CompiledSystem:
         return {"qdd": qdd, "lam": lam, "phi": phi, "Cq": Cq, "nu": nu, "contacts": contacts,
                 "p_loads": float(powers[1])}
 
-    def _table(self, name):
-        k = INT_TABLES.index(name)
-        return self.I[self.io[k]:self.io[k + 1]]
-
-    def _frames_of(self, j):
-        return self._cl_frames[j]
-
     def _jac(self, k, q):
-        i = self._fcol[k]
-        if i < 0:
+        """Frame ``k``'s Jacobian, (3, ndof of its body): the body's own (diagnostics only)."""
+        body, frame = self._frame_list[k]
+        if isinstance(body, Ground):
             return np.zeros((3, 0))
-        floc = self._floc
-        th = q[i + 2]
-        c, s = np.cos(th), np.sin(th)
-        ax = c * floc[k, 0] - s * floc[k, 1]
-        ay = s * floc[k, 0] + c * floc[k, 1]
-        return np.array([[1.0, 0.0, -ay], [0.0, 1.0, ax], [0.0, 0.0, 1.0]])
+        return body.frame_jacobian(np.asarray(q, float)[self.sysm.slices[id(body)]], frame)
 
     def penetration(self, j, q, qd=None):
         """``(delta, delta_dot)`` of clearance joint ``j`` (``delta_dot`` 0 without ``qd``)."""
@@ -627,6 +784,14 @@ class CompiledSystem:
         qd = self._zeros if qd is None else np.ascontiguousarray(qd, float)
         clearance_kinematics(j, q, qd, self.I, self.io, self.F, self.fo, out)
         return out[5], out[6]
+
+
+def _flat(a):
+    """A table as one flat sequence (a list of rows or of arrays of any lengths)."""
+    if isinstance(a, np.ndarray):
+        return a.ravel()
+    parts = [np.ravel(np.asarray(x, float)) for x in a]
+    return np.concatenate(parts) if parts else np.zeros(0)
 
 
 def _pack(arrays, dtype):
