@@ -2,7 +2,6 @@
 machine's cylinder, whose multibody form (crankmodal.dynamics.Cylinder) is built from the
 machine's (crankmodal.mechanism.machine.Cylinder)."""
 
-import dataclasses
 import math
 import pickle
 
@@ -46,18 +45,48 @@ def test_from_machine_points_the_axis_where_the_machine_does(bank_deg):
     assert (dyn.piston_mass, dyn.z, dyn.offset, dyn.ring_friction) == (1.7, 0.05, 0.0, 12.0)
 
 
-def test_from_machine_gives_the_cylinders_the_scene_bridge_builds():
+def _four_star_params():
     from crankmodal.mechanism.stage import validate as validate_mechanism
     from crankmodal.resources import load_machine
 
-    mp = validate_mechanism(load_machine("four_star_compressor")["mechanism"], None)
+    return validate_mechanism(load_machine("four_star_compressor")["mechanism"], None)
+
+
+def test_the_scene_bridge_builds_the_machine_cylinders_with_their_gas_forces():
+    """The bridge's cylinders (built by from_machine) carry the machine's fields, written out
+    here, and a gas force that returns the mechanism analysis' gas force at its own angles."""
+    from crankmodal.mechanism.analysis import analyse
+
+    mp = _four_star_params()
     src = cylinders_from_mechanism(mp, ring_friction=30.0)
     m = mm.machine_from_params(mp)
     assert len(src["cylinders"]) == len(m.cylinders) == 4
-    for built, c in zip(src["cylinders"], m.cylinders):
-        assert built.gas_force is not None
-        assert dataclasses.asdict(Cylinder.from_machine(m, c, built.gas_force, 30.0)) == \
-            dataclasses.asdict(built)
+    res = analyse(m, n_per_rev=720)
+    for i, (built, c) in enumerate(zip(src["cylinders"], m.cylinders)):
+        assert built.axis_angle == np.pi / 2 - c.bank_angle
+        assert (built.rod_length, built.rod_mass, built.rod_inertia, built.rod_com) == \
+            (m.rod.length, m.rod.mass, m.rod.inertia, m.rod.cg_from_big_end)
+        assert (built.piston_mass, built.z, built.offset, built.ring_friction) == \
+            (c.piston_mass, c.axial_offset, 0.0, 30.0)
+        psi = np.asarray(res.psi[:, i])
+        np.testing.assert_allclose([built.gas_force(a) for a in psi],
+                                   np.asarray(res.gas_force)[:, i], rtol=1e-12, atol=1e-9)
+    assert (src["crank_radius"], src["direction"], src["speed_rpm"]) == \
+        (m.crank_radius, -1, m.speed_rpm)
+
+
+def test_the_scene_bridge_refuses_a_cylinder_on_its_own_throw_under_the_scene_key():
+    """A scene user reads the stage's message (SceneError, dynamics.from_mechanism), not the
+    core's ParameterError."""
+    from crankmodal.errors import SceneError
+
+    mp = _four_star_params()
+    mp["cylinders"][2]["throw_angle_deg"] = 90.0
+    with pytest.raises(SceneError) as err:
+        cylinders_from_mechanism(mp)
+    assert not isinstance(err.value, ParameterError)
+    assert str(err.value) == ("dynamics.from_mechanism: cylinders on separate crank throws are "
+                              "not supported yet (throw_angle_deg must be 0)")
 
 
 def test_from_machine_refuses_a_cylinder_on_its_own_throw_naming_the_field():

@@ -28,6 +28,8 @@ def cylinders_from_mechanism(mech_params: dict, ring_friction: float = 0.0):
     from ..mechanism.machine import machine_from_params
 
     m = machine_from_params(mech_params)
+    # checked here, before the analysis, and under the scene's name (Cylinder.from_machine
+    # refuses the same cylinder with a ParameterError naming its argument)
     if any(abs(c.throw_angle) > 0.0 for c in m.cylinders):
         raise SceneError("dynamics.from_mechanism: cylinders on separate crank throws are not "
                          "supported yet (throw_angle_deg must be 0)")
@@ -39,9 +41,6 @@ def cylinders_from_mechanism(mech_params: dict, ring_friction: float = 0.0):
         order = np.argsort(ang)
         ang, force = ang[order], np.asarray(res.gas_force)[order, i]
         gas = tabulated_gas_force(ang, force, cycle) if m.gas is not None else None
-        out.append(Cylinder(axis_angle=np.pi / 2 - c.bank_angle, rod_length=m.rod.length,
-                            rod_mass=m.rod.mass, rod_inertia=m.rod.inertia,
-                            rod_com=m.rod.cg_from_big_end, piston_mass=c.piston_mass,
-                            z=c.axial_offset, gas_force=gas, ring_friction=ring_friction))
+        out.append(Cylinder.from_machine(m, c, gas_force=gas, ring_friction=ring_friction))
     return {"crank_radius": m.crank_radius, "cylinders": out, "direction": -1,
             "speed_rpm": m.speed_rpm, "crank_unbalance": m.crank_unbalance}
