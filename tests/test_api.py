@@ -50,6 +50,9 @@ def test_the_core_objects_the_readme_composes_are_the_expected_kinds():
     assert crankmodal.FlexibleBody.__module__ == "crankmodal.dynamics.flexible"
     assert crankmodal.ReducedBody.__module__ == "crankmodal.reduction.flexbody"
     assert crankmodal.Cylinder.__module__ == "crankmodal.dynamics.mechanisms"
+    # the geometric cylinder (a bore or journal surface) is the other "cylinder"
+    assert crankmodal.CylindricalSurface.__module__ == "crankmodal.part"
+    assert crankmodal.CylindricalSurface is not crankmodal.Cylinder
     assert issubclass(crankmodal.SceneError, crankmodal.CrankmodalError)
     assert callable(crankmodal.run_scene) and callable(crankmodal.select_supports)
 
