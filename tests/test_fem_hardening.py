@@ -187,14 +187,51 @@ def test_a_dense_solve_that_does_not_fit_in_memory_falls_back_to_lanczos(monkeyp
 
 # --- item 12: a support that holds every node --------------------------------------------------
 
+FREE_NOTHING = ("holds every node the elements use in every direction, so nothing is left "
+                "free; support a part of the mesh only (a smaller box or a region) or fix fewer "
+                "components")
+
+
 def test_a_support_box_holding_every_node_says_nothing_is_left_free():
-    """Before: 'modal.n_modes: 4 modes need a finer mesh (only 0 free DOFs)'."""
+    """Before: 'modal.n_modes: 4 modes need a finer mesh (only 0 free DOFs)'. The core names
+    its argument (supports) and the support by its label."""
+    from crankmodal.fem.loads import Load
+    from crankmodal.fem.static import solve_static
+
     part = bar(0.1, 0.02, 0.02, (4, 1, 1), order=1)
     model = assembly.assemble(part, STEEL)
-    sup = supports.select(part, [{"box": [-1, 1, -1, 1, -1, 1]}])
-    with pytest.raises(SceneError, match=r"modal\.supports\[0\] \(box\): holds every node .* "
-                                         r"nothing is left free"):
+    sup = [supports.Support.box(part, [-1, 1, -1, 1, -1, 1])]
+    with pytest.raises(ParameterError) as info:
         modal.solve_modes(model, 4, sup)
+    assert not isinstance(info.value, SceneError) and info.value.argument == "supports"
+    assert str(info.value) == f"supports: box {FREE_NOTHING}"
+    two = sup + [supports.Support.region(part, "end_x0", "x")]
+    with pytest.raises(ParameterError, match=r"^supports: box and region end_x0 hold every node"):
+        solve_static(model, part.mesh, Load.pressure(part, "end_x1", 1e5), two)
+
+
+def test_the_fe_stages_name_the_scene_key_of_supports_holding_every_node(tmp_path):
+    """A scene user reads the scene key and the support's scene label, with the same text."""
+    from pathlib import Path
+
+    from crankmodal.fem import material_stage, modal_stage, static_stage
+    from crankmodal.runner import StageContext
+    from crankmodal.scene import Scene
+
+    scene = Scene(name="t", base_dir=Path("."))
+    ctx = StageContext(scene=scene, out_dir=tmp_path, figures=False)
+    ctx.products["geometry"] = bar(0.1, 0.02, 0.02, (4, 1, 1), order=1)
+    material_stage.run(material_stage.validate({"name": "steel"}, scene), ctx)
+    everything = [{"box": [-1, 1, -1, 1, -1, 1]}]
+    with pytest.raises(SceneError) as info:
+        modal_stage.run(modal_stage.validate({"n_modes": 4, "supports": everything,
+                                              "vtu": False}, scene), ctx)
+    assert str(info.value) == f"modal.supports: modal.supports[0] (box) {FREE_NOTHING}"
+    with pytest.raises(SceneError) as info:
+        static_stage.run(static_stage.validate(
+            {"supports": everything, "loads": [{"region": "end_x1", "pressure": 1e5}],
+             "vtu": False}, scene), ctx)
+    assert str(info.value) == f"static.supports: static.supports[0] (box) {FREE_NOTHING}"
 
 
 # --- item 13: what repeats bit for bit --------------------------------------------------------

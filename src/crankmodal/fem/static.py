@@ -139,8 +139,9 @@ def solve_static(model: FEModel, mesh, load: Load | list | np.ndarray, supports:
     Raises
     ------
     ParameterError
-        Naming ``supports`` if they leave a mechanism (with how many rigid-body modes remain) or
-        are not :class:`Support` objects, ``load`` if it is not a load of this mesh.
+        Naming ``supports`` if they leave a mechanism (with how many rigid-body modes remain),
+        hold every node in every direction or are not :class:`Support` objects, ``load`` if it
+        is not a load of this mesh.
     """
     from ..progress import PhaseTimings
     from .modal import expected_rigid_modes

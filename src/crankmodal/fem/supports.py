@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import ParameterError, SceneError, scene_keys
+from ..errors import ParameterError, scene_keys
 
 AXES = "xyz"
 
@@ -328,8 +328,9 @@ def reduction(points: np.ndarray, used: np.ndarray, supports: list[Support]) -> 
 
     Raises
     ------
-    SceneError
-        The supports leave no degree of freedom free (naming them).
+    ParameterError
+        Naming ``supports``: they leave no degree of freedom free (the text names them by
+        label); a stage re-raises it under its scene key (``modal.supports: ...``).
     """
     n = len(points)
     fixed = np.zeros((n, 3), bool)
@@ -372,9 +373,10 @@ def reduction(points: np.ndarray, used: np.ndarray, supports: list[Support]) -> 
     if ncol == 0 and supports:  # else the caller would ask for a finer mesh, which fixes nothing
         who = " and ".join(s.label for s in supports)
         held = "hold" if len(supports) > 1 else "holds"
-        raise SceneError(f"{who}: {held} every node the elements use in every direction, so "
-                         f"nothing is left free; support a part of the mesh only (a smaller "
-                         f"box or a region) or fix fewer components")
+        raise ParameterError("supports", f"{who} {held} every node the elements use in every "
+                                         f"direction, so nothing is left free; support a part of "
+                                         f"the mesh only (a smaller box or a region) or fix "
+                                         f"fewer components")
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(3 * n, ncol))
 
