@@ -93,7 +93,7 @@ def main(root: Path, figure: Path) -> None:
         print(f"| {r['case']} | {r['modes']} | {r['peak'][0]:.0f} / {r['peak'][1]:.0f} | "
               f"{r['rms'][0]:.0f} / {r['rms'][1]:.0f} | {100 * r['diff']:.2f} % | {o} | "
               f"{r['ripple'][0]:.1f} / {r['ripple'][1]:.1f} | {st} | "
-              f"{r['wall'][0]:.0f} / {r['wall'][1]:.0f} |")
+              f"{r['wall'][0]:.1f} / {r['wall'][1]:.1f} |")
 
 
 
