@@ -131,3 +131,50 @@ def test_clearance_joint_takes_names_or_objects_alike():
     assert ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
                           journal_radius=0.01, law=laws.Flores(stiffness=1e10,
                                                                restitution=0.5)).needs_memory
+
+
+# --- what the contact time scales ask of a law (crankmodal.dynamics.timescales) ---------------
+
+LOADS = (40.0, 3e3, 1e5)  # N; Johnson's approach is valid below 4 K dR e**-3 = 6e5 N here
+
+
+@pytest.mark.parametrize("name", contact.NORMAL_LAWS)
+def test_static_penetration_carries_the_load_and_the_tangent_stiffness_is_its_slope(name):
+    law = laws.make_law(name, FULL)
+    for load in LOADS:
+        d = law.static_penetration(load)
+        assert d > 0.0
+        np.testing.assert_allclose(law.elastic_force(d), load, rtol=1e-9)
+        h = 1e-5 * d  # central difference of the elastic force
+        slope = (law.elastic_force(d + h) - law.elastic_force(d - h)) / (2.0 * h)
+        np.testing.assert_allclose(law.tangent_stiffness(load), slope, rtol=1e-6)
+
+
+@pytest.mark.parametrize("name", contact.NORMAL_LAWS)
+def test_the_dashpot_a_law_brings_of_its_own(name):
+    law = laws.make_law(name, FULL)
+    c, d_max = FULL["damping"], FULL["penetration"]
+    for load in LOADS:
+        d = law.static_penetration(load)
+        s = min(d / d_max, 1.0)
+        expected = {"kelvin_voigt": c, "power_damped": c,
+                    "impact": c * s * s * (3.0 - 2.0 * s)}.get(name, 0.0)  # STEP's cubic
+        assert law.dashpot(load) == pytest.approx(expected, rel=1e-12)
+    has = name in ("kelvin_voigt", "power_damped", "impact")
+    assert law.dashpot_setting == (c if has else None)
+    assert law.dashpot_varies == (name == "impact")
+
+
+@pytest.mark.parametrize("name", contact.NORMAL_LAWS)
+def test_stiffness_for_tangent_gives_that_tangent_stiffness_at_the_same_load(name):
+    law = laws.make_law(name, FULL)
+    load = 3e3
+    k_lin = law.tangent_stiffness(load)
+    for factor in (0.1, 0.5, 20.0):
+        K = law.stiffness_for_tangent(factor * k_lin, k_lin)
+        again = laws.make_law(name, {**FULL, "stiffness": K}).tangent_stiffness(load)
+        if law.tangent_scales_exactly:
+            assert again == pytest.approx(factor * k_lin, rel=1e-10)
+        else:  # johnson_cylinder: K_lin ~ K over a logarithm of F / K
+            assert name == "johnson_cylinder"
+            assert 0.5 * factor * k_lin < again < 2.0 * factor * k_lin

@@ -71,9 +71,22 @@ def test_linear_contact_period_and_damping_time_and_the_key_they_name():
         assert ts.key == key and ts.step == pytest.approx(step)
         assert timescales.estimated_evals(ts, 0.01, "RK45") == pytest.approx(6 * 0.01 / step)
         assert timescales.estimated_evals(ts, 0.01, "Radau") is None
-    # Hertz: K_lin = 1.5 K^(2/3) F^(1/3)
-    cj.law, cj.law_params = "hertz", {"stiffness": 1e10, "exponent": 1.5}
-    assert timescales.tangent_stiffness(cj, 1000.0) == pytest.approx(1.5 * 1e10**(2 / 3) * 10.0)
+    assert ts.law is cj.normal and ts.stiffness == 1e8 and ts.damping_set == c
+
+
+def test_the_time_scales_ask_the_joint_law_object():
+    """Hertz: K_lin = 1.5 K^(2/3) F^(1/3), no dashpot; the estimate follows the joint's law
+    object (a law's own answers are tested in test_dynamics_laws)."""
+    from types import SimpleNamespace
+
+    sysm, cj = _journal(2.0, law="hertz", params={"stiffness": 1e10, "exponent": 1.5})
+    mech = SimpleNamespace(system=sysm, q0=np.zeros(3), qd0=np.zeros(3), revolution_hz=0.0,
+                           crank=cj.journal)
+    (ts,) = timescales.joint_time_scales(mech)
+    assert ts.load == 1.0  # no gas force, no speed: the floor of 1 N
+    assert ts.k_lin == pytest.approx(1.5 * 1e10**(2 / 3) * 1.0**(1 / 3), rel=1e-12)
+    assert ts.damping is None and ts.damping_set is None and ts.key == "contact.stiffness"
+    assert cj.normal.tangent_stiffness(1000.0) == pytest.approx(1.5 * 1e10**(2 / 3) * 10.0)
 
 
 @pytest.mark.parametrize("method", ["RK45", "DOP853", "LSODA", "Radau", "BDF"])
@@ -87,9 +100,10 @@ def test_advice_never_names_the_method_in_use(method):
 def test_over_budget_advice_names_the_damping_when_it_limits_the_step():
     # a kelvin-voigt dashpot of 1e6 N s/m on 2 kg: m/c = 2e-6 s against T/pi = 2.8e-4 s
     sysm, _ = _journal(2.0, params={"stiffness": 1e8, "damping": 1e6})
+    from crankmodal.dynamics.laws import KelvinVoigt
     from crankmodal.dynamics.timescales import TimeScale
-    ts = TimeScale("c", 2.0, 100.0, 1e8, 2 * np.pi * np.sqrt(2e-8), 1e6, 2e-6, "kelvin_voigt",
-                   1e8, 1.0, 1e6)
+    ts = TimeScale("c", 2.0, 100.0, 1e8, 2 * np.pi * np.sqrt(2e-8), 1e6, 2e-6,
+                   KelvinVoigt(1e8, 1e6))
     s = SolverSettings(method="RK45", max_rhs_evals=200, time_scales=(ts,))
     from crankmodal.errors import NumericalError
     with pytest.raises(NumericalError) as exc:

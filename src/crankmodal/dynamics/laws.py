@@ -8,6 +8,12 @@ naming the parameter) and whose methods call the pure functions of :mod:`.contac
 ``elastic_force(delta)``, ``elastic_energy(delta)``
     The conservative part of the law, N, and its potential, J.
 
+For the contact time scales of :mod:`.timescales` a normal law answers under a representative
+load ``F`` (N): ``static_penetration(F)`` (m), ``tangent_stiffness(F)`` (N/m), ``dashpot(F)``
+(its own damping coefficient there, N s/m; 0 for none), ``dashpot_setting`` (the damping
+parameter as set, or None) and ``stiffness_for_tangent(k_target, k_lin)`` (the stiffness
+parameter that would give the tangent stiffness ``k_target`` at the same load).
+
 Laws whose damping depends on the impact velocity have ``needs_impact_velocity = True``. A
 friction law has ``coefficient(v)``: the signed coefficient at slip velocity ``v`` (m/s), the
 friction force being ``-mu F_n``.
@@ -86,6 +92,37 @@ class NormalLaw:
         """Parameters for the compiled kernel: ``[K, n, c, d_or_e, dR]`` (unused entries 0)."""
         raise NotImplementedError
 
+    # --- contact time scales (:mod:`.timescales`) -------------------------------------------
+    #: whether :meth:`dashpot` depends on the penetration a run reaches (then an estimate only)
+    dashpot_varies: ClassVar[bool] = False
+    #: whether :meth:`stiffness_for_tangent` is exact (False: up to a logarithm)
+    tangent_scales_exactly: ClassVar[bool] = True
+
+    def static_penetration(self, load):
+        """Penetration at which the elastic force carries ``load`` N: ``(F / K)**(1/n)``, m."""
+        return (load / self.stiffness) ** (1.0 / self.elastic_exponent)
+
+    def tangent_stiffness(self, load):
+        """``dF/d delta`` of the elastic force at :meth:`static_penetration` of ``load`` N:
+        ``n F / delta``, N/m."""
+        return self.elastic_exponent * load / self.static_penetration(load)
+
+    def dashpot(self, load):
+        """The law's own damping coefficient at the static penetration of ``load`` N, N s/m;
+        0 for a law without a dashpot (the hysteresis laws damp through the restitution)."""
+        return 0.0
+
+    @property
+    def dashpot_setting(self) -> float | None:
+        """The damping parameter as set (N s/m), or None for a law without a dashpot."""
+        return None
+
+    def stiffness_for_tangent(self, k_target: float, k_lin: float) -> float:
+        """The stiffness parameter whose tangent stiffness at the same load would be
+        ``k_target`` N/m, given ``k_lin`` at the present one: ``K_lin`` goes as ``K**(1/n)``
+        (``n F / delta`` with ``delta = (F/K)**(1/n)``), so ``K (k_target / k_lin)**n``."""
+        return self.stiffness * (k_target / k_lin) ** self.elastic_exponent
+
 
 @dataclass(frozen=True)
 class Hertz(NormalLaw):
@@ -128,6 +165,26 @@ class KelvinVoigt(NormalLaw):
     def vector(self):
         return np.array([self.stiffness, 1.0, self.damping, 0.0, 0.0])
 
+    def static_penetration(self, load):
+        """``F / K``, m."""
+        return load / self.stiffness
+
+    def tangent_stiffness(self, load):
+        """``K`` at every load, N/m."""
+        return self.stiffness
+
+    def dashpot(self, load):
+        """``damping`` at every load, N s/m."""
+        return self.damping
+
+    @property
+    def dashpot_setting(self):
+        return self.damping
+
+    def stiffness_for_tangent(self, k_target, k_lin):
+        """``k_target`` itself (the tangent stiffness is ``K``)."""
+        return k_target
+
 
 @dataclass(frozen=True)
 class PowerDamped(NormalLaw):
@@ -149,6 +206,14 @@ class PowerDamped(NormalLaw):
 
     def vector(self):
         return np.array([self.stiffness, self.exponent, self.damping, 0.0, 0.0])
+
+    def dashpot(self, load):
+        """``damping`` at every load, N s/m."""
+        return self.damping
+
+    @property
+    def dashpot_setting(self):
+        return self.damping
 
 
 @dataclass(frozen=True)
@@ -177,6 +242,19 @@ class Impact(NormalLaw):
 
     def vector(self):
         return np.array([self.stiffness, self.exponent, self.damping, self.penetration, 0.0])
+
+    dashpot_varies: ClassVar[bool] = True
+
+    def dashpot(self, load):
+        """``STEP(delta, 0, 0, penetration, damping)`` at the static penetration of ``load``,
+        N s/m: an estimate only (the penetration of a run wanders around it)."""
+        d = self.static_penetration(load)
+        return float(contact.step(d, 0.0, 0.0, self.penetration, self.damping))
+
+    @property
+    def dashpot_setting(self):
+        """``damping``: the full damping ``c_max`` the STEP ramp reaches, N s/m."""
+        return self.damping
 
 
 @dataclass(frozen=True)
@@ -265,6 +343,23 @@ class JohnsonCylinder(NormalLaw):
 
     def vector(self):
         return np.array([self.stiffness, 1.0, 0.0, self.restitution, self.radial_clearance])
+
+    #: ``K_lin`` goes as ``K`` up to a logarithm
+    tangent_scales_exactly: ClassVar[bool] = False
+
+    def static_penetration(self, load):
+        """Johnson's approach under ``load`` N (:func:`.contact.johnson_cylinder_approach`), m."""
+        return float(contact.johnson_cylinder_approach(load, self.stiffness,
+                                                       self.radial_clearance))
+
+    def tangent_stiffness(self, load):
+        """:func:`.contact.johnson_cylinder_stiffness` at the static penetration, N/m."""
+        return float(contact.johnson_cylinder_stiffness(self.static_penetration(load),
+                                                        self.stiffness, self.radial_clearance))
+
+    def stiffness_for_tangent(self, k_target, k_lin):
+        """``K k_target / k_lin`` (``K_lin`` is ``K`` over a logarithm of the load), N/m."""
+        return self.stiffness * k_target / k_lin
 
 
 #: normal force laws by name

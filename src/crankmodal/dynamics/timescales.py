@@ -20,6 +20,10 @@ ground or a driven crank counts as infinitely heavy through the constraints.
 Representative load (for the tangent stiffness of non-linear laws): the larger of the peak gas
 force on a piston and ``m omega**2 r`` (the effective mass on the crank radius at full speed);
 ``K_lin`` varies as its ``1 - 1/n`` power (``1/3`` for Hertz), so a rough load is enough.
+
+What a law contributes (its static penetration, tangent stiffness and dashpot under that load,
+and the stiffness that would give another tangent stiffness) the law object answers
+(:class:`crankmodal.dynamics.laws.NormalLaw`); this module knows no law by name.
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import contact
+from .laws import NormalLaw
 
 #: evaluations of the right-hand side per accepted step of the explicit methods
 EVALS_PER_STEP = {"RK45": 6, "DOP853": 12}
@@ -39,8 +43,6 @@ WARN_FRACTION = 0.2
 #: evaluations of the slider-crank at damping = 1e7, 0.75x those of the four-star at
 #: stiffness = 1e12)
 REFUSE_FACTOR = 3.0
-#: laws with a dashpot set by ``contact.damping`` (N s/m); impact: its full damping ``c_max``
-DAMPED_LAWS = ("kelvin_voigt", "power_damped", "impact")
 
 
 @dataclass
@@ -54,16 +56,23 @@ class TimeScale:
     period: float          # T_K = 2 pi sqrt(m / K_lin), s
     damping: float | None  # dashpot c, N s/m (None: the law has none of its own)
     damping_time: float | None  # m / c, s
-    law: str
-    stiffness: float       # the law's stiffness parameter (contact.stiffness)
-    exponent: float
-    damping_set: float | None = None  # contact.damping as given, N s/m
+    law: NormalLaw         # the joint's normal law (crankmodal.dynamics.laws)
+
+    @property
+    def stiffness(self) -> float:
+        """The law's stiffness parameter (``contact.stiffness``)."""
+        return self.law.stiffness
+
+    @property
+    def damping_set(self) -> float | None:
+        """``contact.damping`` as given, N s/m (None: the law has no dashpot)."""
+        return self.law.dashpot_setting
 
     @property
     def firm(self) -> bool:
-        """Whether the estimate is firm enough to refuse a run: not for ``impact``'s damping,
-        which depends on the penetration the run reaches (:func:`dashpot`)."""
-        return not (self.key == "contact.damping" and self.law == "impact")
+        """Whether the estimate is firm enough to refuse a run: not for a damping that depends
+        on the penetration the run reaches (``impact``'s, :meth:`NormalLaw.dashpot`)."""
+        return not (self.key == "contact.damping" and self.law.dashpot_varies)
 
     @property
     def step(self) -> float:
@@ -84,7 +93,7 @@ class TimeScale:
         """``contact.<key> = value (its time scale)``, for messages."""
         if self.key == "contact.damping":
             c = f"{self.damping:.3g} N s/m"
-            if self.law == "impact":  # its STEP ramp: the value set is the full damping
+            if self.law.dashpot_varies:  # impact's STEP ramp: the value set is the full one
                 c = f"{self.damping_set:.3g} N s/m ({self.damping:.3g} at the static penetration)"
             return (f"contact.damping = {c} (damping time m/c = {self.damping_time:.2g} s with "
                     f"the effective mass {self.mass:.3g} kg)")
@@ -137,46 +146,6 @@ def _crank_radius(crank) -> float:
     return max((float(np.hypot(*(a - b)[:2])) for a in pts for b in pts), default=0.0)
 
 
-def static_penetration(cj, load: float) -> float:
-    """Penetration at which the joint's elastic force carries ``load`` N, m."""
-    p = cj.law_params
-    K = float(p["stiffness"])
-    if cj.law == "kelvin_voigt":
-        return load / K
-    if cj.law == "johnson_cylinder":
-        return float(contact.johnson_cylinder_approach(load, K, p["radial_clearance"]))
-    return (load / K) ** (1.0 / float(p.get("exponent", 1.5)))
-
-
-def tangent_stiffness(cj, load: float) -> float:
-    """Tangent stiffness of the joint's law at the penetration that carries ``load`` N, N/m."""
-    p = cj.law_params
-    K = float(p["stiffness"])
-    d = static_penetration(cj, load)
-    if cj.law == "kelvin_voigt":
-        return K
-    if cj.law == "johnson_cylinder":
-        return float(contact.johnson_cylinder_stiffness(d, K, p["radial_clearance"]))
-    return float(p.get("exponent", 1.5)) * load / d
-
-
-def dashpot(cj, load: float) -> float:
-    """The law's damping coefficient at the static penetration of ``load``, N s/m (0: none).
-
-    ``impact`` ramps its damping from 0 to ``c_max`` over ``penetration`` (ADAMS STEP): the
-    value at the static penetration is used, and it is an estimate only (the penetration of
-    a run wanders around it; measured: the four-star at ``damping = 1e7`` took 10x fewer
-    evaluations than this damping implies).
-    """
-    if cj.law not in DAMPED_LAWS:
-        return 0.0
-    c = float(cj.law_params.get("damping", 0.0))
-    if cj.law == "impact":
-        d = static_penetration(cj, load)
-        c = float(contact.step(d, 0.0, 0.0, float(cj.law_params["penetration"]), c))
-    return c
-
-
 def joint_time_scales(mech) -> list[TimeScale]:
     """The time scales of every clearance joint of a mechanism at its initial state."""
     sysm = mech.system
@@ -189,17 +158,15 @@ def joint_time_scales(mech) -> list[TimeScale]:
         if not np.isfinite(m):
             continue
         load = max(gas, m * omega**2 * r, 1.0)
+        law = cj.normal
         with np.errstate(all="ignore"):  # extreme exponents/stiffnesses: no estimate, no error
-            k = float(np.float64(tangent_stiffness(cj, np.float64(load))))
-            c = float(np.float64(dashpot(cj, np.float64(load))))
+            k = float(np.float64(law.tangent_stiffness(np.float64(load))))
+            c = float(np.float64(law.dashpot(np.float64(load))))
         if not (np.isfinite(k) and k > 0.0 and np.isfinite(c)):
             continue
         out.append(TimeScale(
             joint=cj.name, mass=m, load=load, k_lin=k, period=2.0 * np.pi * np.sqrt(m / k),
-            damping=c if c > 0.0 else None, damping_time=m / c if c > 0.0 else None,
-            law=cj.law, stiffness=float(cj.law_params["stiffness"]),
-            exponent=float(cj.law_params.get("exponent", 1.5)),
-            damping_set=cj.law_params.get("damping") if cj.law in DAMPED_LAWS else None))
+            damping=c if c > 0.0 else None, damping_time=m / c if c > 0.0 else None, law=law))
     return out
 
 
@@ -215,12 +182,9 @@ def _allowed(ts: TimeScale, h_needed: float) -> str:
     if ts.key == "contact.damping":
         return f"<= {2.0 * ts.mass / h_needed:.3g} N s/m"
     k_lin_max = 4.0 * ts.mass / h_needed**2
-    if ts.law == "kelvin_voigt":
-        k = k_lin_max
-    elif ts.law == "johnson_cylinder":  # K_lin ~ K up to a logarithm
-        return f"about <= {ts.stiffness * k_lin_max / ts.k_lin:.3g} N/m"
-    else:  # K_lin = n K**(1/n) F**(1-1/n)
-        k = ts.stiffness * (k_lin_max / ts.k_lin) ** ts.exponent
+    k = ts.law.stiffness_for_tangent(k_lin_max, ts.k_lin)
+    if not ts.law.tangent_scales_exactly:  # johnson_cylinder: K_lin ~ K up to a logarithm
+        return f"about <= {k:.3g} N/m"
     return f"<= {k:.3g}"
 
 
