@@ -67,26 +67,39 @@ plt.show()
 
 # %% [markdown]
 # ## 3. Supports, a bearing load and a static solve
-# Supports by region name (or by a box); loads are nodal force vectors built from a region's
-# facets. Big-end eye clamped, 10 kN pull on the small-end eye as a pin pressing the bore.
+# A `Support` holds a region's nodes (`Support.region`, or the nodes inside a box with
+# `Support.box`); a `Load` holds the nodal forces of a pressure, a traction, a remote force or a
+# pin's bearing load on a region (loads add: `a + b`, `sum(...)`, `2 * a`). Big-end eye clamped,
+# 10 kN pull on the small-end eye as a pin pressing the bore.
 
 # %%
-supports = cm.select_supports(rod, [{"region": "big_end_bore", "fix": "xyz"}])
-clamped = cm.solve_modes(model, n_modes=3, supports=supports)
+clamp = [cm.Support.region(rod, "big_end_bore", fix="xyz")]
+clamped = cm.solve_modes(model, n_modes=3, supports=clamp)
 print("clamped at the big end:", np.round(clamped.frequencies_hz, 1), "Hz")
-eye = rod.regions["small_end_bore"]
-F = 10e3
-load = cm.bearing_load(model.points, rod.mesh.cells[0].data, eye.facets,
-                       force=[F, 0.0, 0.0], axis=eye.cylinder.axis)
-static = cm.solve_static(model, rod.mesh, load, supports)
+assert clamped.rigid_body_modes == 0 and clamped.frequencies_hz[0] < modes.frequencies_hz[0]
+F = 10e3                                                     # N along +x, the rod's axis
+pull = cm.Load.bearing(rod, "small_end_bore", force=[F, 0.0, 0.0])
+assert np.allclose(pull.resultant, [F, 0.0, 0.0], rtol=0, atol=1e-9 * F)
+static = cm.solve_static(model, rod.mesh, pull, clamp)
 p = rod_params
 area = 2 * p.shank_width * p.shank_flange_thickness \
     + p.shank_web_thickness * (p.shank_depth - 2 * p.shank_flange_thickness)
 mid = np.abs(model.points[:, 0] - p.length / 2) < 0.01
 print(f"max von Mises {static.max_von_mises / 1e6:.1f} MPa; mid-shank sigma_xx "
       f"{np.median(static.stress[mid, 0, 0]) / 1e6:.2f} MPa, F/A {F / area / 1e6:.2f} MPa")
-assert np.allclose(static.reaction, [-F, 0.0, 0.0], atol=1e-4 * F)
+assert np.allclose(static.reaction, [-F, 0.0, 0.0], atol=1e-4 * F)   # equilibrium
 assert abs(np.median(static.stress[mid, 0, 0]) / (F / area) - 1) < 0.05
+
+# %% [markdown]
+# A mistake names the argument: a region the part does not have raises `ParameterError`.
+
+# %%
+try:
+    cm.Load.bearing(rod, "crankpin", force=[F, 0.0, 0.0])
+    raise AssertionError("a region the rod does not have must be refused")
+except cm.ParameterError as err:
+    print(err)
+    assert err.argument == "region"
 
 # %%
 fig, ax = plt.subplots(figsize=(9, 3.2))
@@ -154,6 +167,7 @@ ax.legend(loc="upper left")
 fig.tight_layout()
 plt.show()
 
+
 # %% [markdown]
 # ## 6. A dynamics run built from body objects
 # A single-cylinder slider-crank at 1480 rpm with the flexible rod of section 4 (3 in-plane
@@ -179,7 +193,7 @@ m_rec = 1.2 + rod_flex.mass * np.hypot(*rod_flex.frames["big"][0]) / Lr
 m_rot = rod_flex.mass - (m_rec - 1.2)
 f_tdc = m_rot * r * w**2 + m_rec * r * w**2 * (1 + r / Lr)
 peaks = {k: np.hypot(*h.main_bearing_force[h.t > 0.04].T).max() for k, h in runs.items()}
-print({k: round(v, 1) for k, v in peaks.items()}, "N; closed form at TDC", round(f_tdc, 1), "N")
+print({k: round(float(v), 1) for k, v in peaks.items()}, "N; closed form at TDC", round(f_tdc, 1), "N")
 assert abs(peaks["rigid"] / f_tdc - 1) < 1e-3 and abs(peaks["flexible"] / peaks["rigid"] - 1) < 0.01
 
 # %%
@@ -190,8 +204,9 @@ for label, h in runs.items():
     ax[0].plot(deg, np.hypot(*h.main_bearing_force[sel].T), label=label,
                ls="-" if label == "flexible" else "--")
 ax[0].axhline(f_tdc, color="k", lw=0.8, ls=":", label="closed form at TDC")
-ax[0].set(ylabel="|main-bearing force| (N)", title="slider-crank, 1480 rpm, inertia loads")
-ax[0].legend()
+ax[0].set(ylabel="|main-bearing force| (N)", title="slider-crank, 1480 rpm, inertia loads",
+          ylim=(0, 1.3 * f_tdc))
+ax[0].legend(loc="upper center", ncols=3)
 h = runs["flexible"]
 sel = h.t > 0.04
 xi = h.modal["rod_1"]                      # (samples, modes): the rod's modal coordinates
