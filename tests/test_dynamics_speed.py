@@ -32,6 +32,17 @@ def _slider_crank(law, friction, params=PARAMS):
                        contact_kw=kw, gravity=(0.0, -9.81))
 
 
+def _states(mech, seed, count):
+    """``count`` random states near the mechanism's start: ``(t, q, qd, y, v_impact)``."""
+    n = mech.system.n
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        q = mech.q0 + rng.normal(0.0, 1.5e-4, n)
+        qd = mech.qd0 + rng.normal(0.0, 0.3, n)
+        t = rng.uniform(0.0, 0.05)
+        yield t, q, qd, np.concatenate([q, qd, np.zeros(6)]), rng.uniform(0.01, 2.0)
+
+
 def _both(sysm, fn, *args):
     sysm.compiled = False
     a = fn(*args)
@@ -48,14 +59,9 @@ def test_compiled_rhs_and_solve_equal_the_python_path_state_by_state(law, fricti
     assert sysm.kernel() is not None
     cj = sysm.clearances[0]
     n = sysm.n
-    rng = np.random.default_rng(7)
     in_contact = 0
-    for _ in range(12):
-        q = mech.q0 + rng.normal(0.0, 1.5e-4, n)
-        qd = mech.qd0 + rng.normal(0.0, 0.3, n)
-        t = rng.uniform(0.0, 0.05)
-        cj.v_impact = rng.uniform(0.01, 2.0)  # restitution laws read it at each call
-        y = np.concatenate([q, qd, np.zeros(6)])
+    for t, q, qd, y, v_impact in _states(mech, 7, 12):
+        cj.v_impact = v_impact  # restitution laws read it at each call
         py, co = _both(sysm, sysm.rhs, t, y)
         scale = np.maximum(np.abs(py), 1e-300)
         for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
@@ -174,14 +180,9 @@ def test_flexible_bodies_compiled_equal_the_python_path_state_by_state():
     sysm = mech.system
     assert sysm.kernel() is not None and sysm.kernel()._size == sysm.n + sysm.m
     n = sysm.n
-    rng = np.random.default_rng(11)
     in_contact = 0
-    for _ in range(10):
-        q = mech.q0 + rng.normal(0.0, 1.5e-4, n)
-        qd = mech.qd0 + rng.normal(0.0, 0.3, n)
-        t = rng.uniform(0.0, 0.05)
-        y = np.concatenate([q, qd, np.zeros(6)])
-        vimp = np.array([rng.uniform(0.01, 2.0)])
+    for t, q, qd, y, v_impact in _states(mech, 11, 10):
+        vimp = np.array([v_impact])  # passed as the integrator passes it
         py, co = _both(sysm, sysm.rhs, t, y, vimp)
         assert py[2 * n + 5] > 0.0  # modal damping power counted
         for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
