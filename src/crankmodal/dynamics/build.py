@@ -71,7 +71,8 @@ def build_mechanism(p, mechanism_params=None, bodies=None):
     ``mechanism_params`` are the validated ``[mechanism]`` parameters, used when
     ``p["from_mechanism"]`` is set. ``bodies`` (crank trains): ``{"crank": (body, roles) or
     None, "rods": [body or None per cylinder] or None}`` replacing the rigid crank and rods
-    made from the parameters (:mod:`.flexbuild`).
+    made from the parameters (:mod:`.flexbuild`); four-bar: ``{"links": {role: body}}``
+    (roles crank, coupler, rocker).
     """
     bodies = bodies or {}
     crank, roles = bodies.get("crank") or (None, None)
@@ -101,7 +102,8 @@ def build_mechanism(p, mechanism_params=None, bodies=None):
         return four_bar(*fb["lengths"], rocker_pivot=fb["rocker_pivot"], masses=fb["masses"],
                         inertias=fb["inertias"], com_fractions=fb["com_fractions"],
                         extra_rocker_inertia=fb["extra_rocker_inertia"], branch=fb["branch"],
-                        **common)
+                        **common, **{f"{role}_body": b
+                                     for role, b in (bodies.get("links") or {}).items()})
     L = ct["rod_length"]
     angles = cylinder_angles(p)
     z = ct["row_z"] or [0.0] * len(angles)

@@ -11,6 +11,9 @@ interfaces, the reduction settings and the reduction package's source), then rea
   if the part has one, else the first journal); body axes turned so that the frame angle is the
   crank angle (pin along +x), with the two rigid tilts (a shaft held at two journals).
 - rod: ``big`` and ``small`` (the bores), body x axis from the big to the small end.
+- four-bar link (:func:`link_body`): its two joints (crank ``A``/``B``, coupler ``B``/``C``,
+  rocker ``D``/``C``), body x axis from the first to the second; from a file, or a prismatic
+  bar between two pins reduced here (:func:`reduced_bar`).
 """
 
 from __future__ import annotations
@@ -237,6 +240,113 @@ def rod_body(source, spec: dict, rod_length: float | None, name: str, z: float =
     return body
 
 
+def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
+    """The ``crankmodal-flexbody`` file of a prismatic steel (or ``spec["material"]``) bar
+    between two pins, reduced once and cached.
+
+    A link for a mechanism with no part of its own (the seed-001 loom's four-bar): a
+    structured tetrahedral bar (:func:`crankmodal.fem.testparts.bar`, no gmsh) along x of
+    ``length`` (m, the distance between the joints), in-plane width ``section[0]`` and
+    thickness ``section[1]`` (m), about ``spec["mesh_size"]`` (m) per element edge, reduced
+    (Craig–Bampton, ``spec["fixed_interface_modes"]``) on its two end faces ``end_x0`` and
+    ``end_x1`` with distributing (RBE3) couplings: each joint is the mean motion of an end face,
+    at the face centre. ``key`` names the scene table in messages.
+    """
+    from ..fem.assembly import assemble
+    from ..fem.material_stage import make_material
+    from ..fem.material_stage import validate as validate_material
+    from ..fem.testparts import bar
+    from ..reduction.interfaces import make_interfaces
+    from ..reduction.io import save_flexbody
+    from ..reduction.reduce import reduce_body
+
+    width, thickness = (float(v) for v in section)
+    h = spec["mesh_size"]
+    div = tuple(max(1, int(np.ceil(d / h))) for d in (length, width, thickness))
+    try:
+        mp = validate_material({"name": spec["material"]}, None)
+    except SceneError as exc:
+        raise SceneError(f"{key}.material: {exc}") from None
+    key_text = json.dumps({"bar": [length, width, thickness], "divisions": div,
+                           "order": spec["element_order"], "material": spec["material"],
+                           "modes": spec["fixed_interface_modes"],
+                           "source": _reduction_source_digest(), "format": 1}, sort_keys=True)
+    digest = hashlib.sha256(key_text.encode()).hexdigest()[:32]
+    path = flexbody_cache_dir() / f"bar_{digest}.npz"
+    if path.is_file():
+        return path
+    part = bar(length, width, thickness, div, order=spec["element_order"])
+    mat = make_material(mp)
+    model = assemble(part, mat)
+    itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
+                                 for n in ("end_x0", "end_x1")])
+    body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"], mesh=part.mesh,
+                          name="bar", info={"part": "bar", "material": mat.name,
+                                            "length_m": length, "section_m": [width, thickness]})
+    path.parent.mkdir(parents=True, exist_ok=True)
+    save_flexbody(path, body)  # atomic
+    return path
+
+
+def link_body(source, spec: dict, length: float | None, role: str, name: str | None = None,
+              key: str | None = None):
+    """A planar flexible four-bar link from a flexbody file (or that body read already).
+
+    Parameters
+    ----------
+    source : str, Path or reduced body
+    spec : dict
+        ``n_modes`` / ``cutoff_hz`` / ``damping_ratio`` and ``interfaces``: the file's two
+        interfaces carrying the link's joints, in the order of
+        :data:`~.mechanisms.FOUR_BAR_JOINTS` (crank A, B; coupler B, C; rocker D, C); None: the
+        file's two interfaces in stored order (it must have exactly two).
+    length : float or None
+        The mechanism's link length, m, checked against the interfaces' distance (±1 %).
+    role : {"crank", "coupler", "rocker"}
+    name : str, optional
+        Body name (default: ``role``).
+    key : str, optional
+        Scene table named in messages (default ``dynamics.flexible.<role>``).
+
+    Returns
+    -------
+    FlexibleBody
+        Frames named for its joints (aliases of the interfaces), body x axis from the first
+        joint to the second; ``info["roles"]`` maps joint to interface.
+    """
+    from .flexible import planar_body
+    from .mechanisms import FOUR_BAR_JOINTS
+
+    key = key or f"dynamics.flexible.{role}"
+    fb, path = read(source)
+    c = _centres(fb)
+    names = spec.get("interfaces")
+    if names is None:
+        if len(c) != 2:
+            raise SceneError(f"{key}.interfaces: {path}: has {len(c)} interfaces "
+                             f"({', '.join(c) or 'none'}); name the two carrying the "
+                             f"{role}'s joints {' and '.join(FOUR_BAR_JOINTS[role])}")
+        names = list(c)
+    for n in names:
+        if n not in c:
+            raise SceneError(f"{key}.interfaces: {path}: no interface {n!r}; interfaces: "
+                             f"{', '.join(c) or 'none'}")
+    d = c[names[1]][:2] - c[names[0]][:2]
+    dist = float(np.hypot(*d))
+    if length is not None and not abs(dist / length - 1) <= GEOMETRY_TOLERANCE:
+        raise SceneError(f"{key}.file: {path}: its interfaces {names[0]!r} and {names[1]!r} "
+                         f"are {dist:.5g} m apart, the mechanism's {role} length is "
+                         f"{length:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
+    body = planar_body(fb, name or role, n_modes=spec.get("n_modes"),
+                       cutoff_hz=spec.get("cutoff_hz"), damping_ratio=spec["damping_ratio"],
+                       orientation=_in_plane_angle(d), path=path)
+    joints = FOUR_BAR_JOINTS[role]
+    for j, n in zip(joints, names):
+        body.alias(j, n)
+    body.info["roles"] = dict(zip(joints, names))
+    return body
+
+
 def rigid_twin(body):
     """The rigid body with a flexible body's mass, inertia and frames (its modes frozen).
 
@@ -253,5 +363,5 @@ def rigid_twin(body):
     return RigidBody(body.name, body.mass, body.j0, frames, z=body.z)
 
 
-__all__ = ["crank_body", "crank_interface_specs", "flexbody_cache_dir", "read", "reduced_part",
-           "rigid_twin", "rod_body"]
+__all__ = ["crank_body", "crank_interface_specs", "flexbody_cache_dir", "link_body", "read",
+           "reduced_bar", "reduced_part", "rigid_twin", "rod_body"]

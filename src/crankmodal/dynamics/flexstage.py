@@ -5,7 +5,9 @@
 :func:`flexible_results` compares a flexible run with its rigid twin: the main-bearing force
 (sum and per journal: peak, RMS, order amplitudes, the RMS of the difference), the modal
 coordinates, the interfaces' elastic deflections and the dynamic stress of each flexible body
-from its stress modes (largest von Mises over the run: where and when).
+from its stress modes (largest von Mises over the run: where and when). For the four-bar
+(:func:`make_links`: crank, coupler, rocker from a file or a bar reduced here) the "main bearing"
+is the crank's ground joint A, and the joints B, C, D are compared as well.
 """
 
 from __future__ import annotations
@@ -46,17 +48,53 @@ def _file(spec, machine, part, n_rods, key):
     return reduced_part(machine, part, spec, n_rods=n_rods)
 
 
+def link_length(p, role: str) -> float:
+    """The four-bar's length of link ``role`` (crank, coupler, rocker), m."""
+    from .scene_keys import FOUR_BAR_LINKS
+
+    return float(p["four_bar"]["lengths"][FOUR_BAR_LINKS.index(role)])
+
+
+def make_links(p) -> dict:
+    """Four-bar: ``{"crank": None, "rods": None, "links": {role: body}, "files": {role: path}}``
+    from the validated ``[dynamics.flexible]`` link tables (a file, or a bar reduced here)."""
+    from ..errors import InputFileError
+    from .flexbuild import link_body, reduced_bar
+    from .scene_keys import FOUR_BAR_LINKS
+
+    out = {"crank": None, "rods": None, "links": {}, "files": {}}
+    for role in FOUR_BAR_LINKS:
+        spec = p["flexible"][role]
+        if spec is None:
+            continue
+        key = f"dynamics.flexible.{role}"
+        length = link_length(p, role)
+        try:
+            path = Path(spec["file"]) if spec["file"] is not None else \
+                reduced_bar(length, spec["bar"], spec, key)
+            out["links"][role] = link_body(path, spec, length, role)
+        except (SceneError, InputFileError) as exc:
+            if str(exc).startswith("dynamics."):
+                raise
+            raise type(exc)(f"{key}: {exc}") from None
+        out["files"][role] = str(path)
+    return out
+
+
 def make_bodies(p, mechanism_params=None) -> dict | None:
     """Flexible bodies of validated ``[dynamics]`` parameters, or None when all are rigid.
 
     Returns ``{"crank": (body, roles) or None, "rods": [body per cylinder] or None,
-    "files": {name: path}}``.
+    "files": {name: path}}``; for the four-bar :func:`make_links`.
     """
     from .flexbuild import crank_body, read, rod_body
+    from .scene_keys import flexible_keys
 
     flex = p["flexible"]
-    if flex["crank"] is None and flex["rods"] is None:
+    if not flexible_keys(p):
         return None
+    if p["mechanism"] == "four_bar":
+        return make_links(p)
     from ..errors import InputFileError
 
     radius, lengths, rows = train_geometry(p, mechanism_params)
@@ -88,6 +126,8 @@ def rigid_twins(bodies: dict) -> dict:
     from .flexbuild import rigid_twin
 
     out = {"crank": None, "rods": None}
+    if bodies.get("links"):
+        out["links"] = {role: rigid_twin(b) for role, b in bodies["links"].items()}
     if bodies.get("crank") is not None:
         body, roles = bodies["crank"]
         out["crank"] = (rigid_twin(body), roles)
@@ -190,6 +230,8 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
         d["not_offered_hz"] = [m["hz"] for m in lo.get("not_offered", [])]
         if "roles" in b.info:
             d["interfaces"] = b.info["roles"]
+        if "extra_inertia_kgm2" in b.info:  # the four-bar's sley on a flexible rocker
+            d["extra_inertia_kgm2"] = b.info["extra_inertia_kgm2"]
         stress = dynamic_stress(b, modal[sel], t, hist.crank_angle[sel])
         if stress is not None:
             d["dynamic_stress"] = stress
@@ -203,6 +245,10 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
                 cmp[name] = force_comparison(t, hist.joint_forces[name][sel],
                                              rigid_hist.joint_forces[name][sel], rev_hz, orders)
         for name in hist.joint_forces:
+            if mech.kind == "four_bar" and name != mech.main_joint \
+                    and name in rigid_hist.joint_forces:  # joints B, C, D besides A
+                cmp[name] = force_comparison(t, hist.joint_forces[name][sel],
+                                             rigid_hist.joint_forces[name][sel], rev_hz, orders)
             if name.startswith("big_end_") and name in rigid_hist.joint_forces:
                 cmp[name] = force_comparison(t, hist.joint_forces[name][sel],
                                              rigid_hist.joint_forces[name][sel], rev_hz, orders)
@@ -211,4 +257,4 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
 
 
 __all__ = ["dynamic_stress", "flexible_results", "force_comparison", "interface_deflections",
-           "make_bodies", "rigid_twins", "train_geometry"]
+           "link_length", "make_bodies", "make_links", "rigid_twins", "train_geometry"]

@@ -289,11 +289,74 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
                    main_joint=main_names[0], main_joints=main_names)
 
 
+#: relative tolerance on the distance between a link body's two joint frames and its length
+LINK_TOLERANCE = 0.01
+
+#: the two joint frames of each four-bar link (body x axis from the first to the second)
+FOUR_BAR_JOINTS = {"crank": ("A", "B"), "coupler": ("B", "C"), "rocker": ("D", "C")}
+
+
+def _link_length(body, role: str, length: float) -> float:
+    """Distance between a given link body's two joint frames (undeformed), m, checked against
+    the link's ``length`` (±:data:`LINK_TOLERANCE`)."""
+    from ..errors import ParameterError
+
+    f0, f1 = FOUR_BAR_JOINTS[role]
+    missing = [f for f in (f0, f1) if f not in body.frames]
+    if missing:
+        raise ParameterError(f"{role}_body", f"needs frames {f0!r} and {f1!r} (the joints it "
+                             f"carries); it has {', '.join(body.frames) or 'none'}")
+    d = float(np.hypot(*(body.local(f1)[0] - body.local(f0)[0])))
+    if not abs(d / length - 1.0) <= LINK_TOLERANCE:
+        raise ParameterError(f"{role}_body", f"its frames {f0!r} and {f1!r} are {d:.5g} m apart, "
+                             f"the {role} length is {length:.5g} m (tolerance "
+                             f"{LINK_TOLERANCE:.0%})")
+    return d
+
+
+def _with_extra_inertia(body, extra: float):
+    """A copy of ``body`` with ``extra`` (kg m²) added to its polar moment about its centre of
+    mass (a rigid body's ``inertia``, a flexible body's ``j0``)."""
+    import copy
+
+    if extra == 0.0:
+        return body
+    twin = copy.copy(body)
+    if isinstance(body, RigidBody):
+        twin.inertia = body.inertia + extra
+        return twin
+    for cache in ("_stacked", "_geo", "_bias"):
+        twin.__dict__.pop(cache, None)
+    twin.j0 = body.j0 + extra
+    twin.info = dict(body.info, extra_inertia_kgm2=extra)
+    return twin
+
+
+def _place(body, f0, f1, X0, X1):
+    """Coordinates of a body whose (undeformed) frames ``f0`` and ``f1`` lie on the line from
+    ``X0`` towards ``X1`` with ``f0`` at ``X0``: ``(x, y, phi, 0 …)``."""
+    s0, s1 = body.local(f0)[0], body.local(f1)[0]
+    ds, dX = s1 - s0, np.asarray(X1) - np.asarray(X0)
+    phi = float(np.arctan2(dX[1], dX[0]) - np.arctan2(ds[1], ds[0]))
+    A = np.array([[np.cos(phi), -np.sin(phi)], [np.sin(phi), np.cos(phi)]])
+    R = np.asarray(X0) - A @ s0
+    return np.concatenate([R, [phi], np.zeros(body.ndof - 3)])
+
+
 def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, inertias,
              speed_rpm, com_fractions=(0.0, 0.5, 0.5), extra_rocker_inertia=0.0, theta0=0.0,
              ramp_time=0.0, drive_torque=None, branch=1, clearances=None, contact_kw=None,
-             gravity=(0.0, 0.0), baumgarte=None, direction=1):
+             gravity=(0.0, 0.0), baumgarte=None, direction=1, crank_body=None,
+             coupler_body=None, rocker_body=None):
     """Four-bar crank-rocker: crank A-B, coupler B-C, rocker D-C; joints ``A, B, C, D``.
+
+    Each link is a rigid body made from the parameters, or the body object given (rigid or
+    flexible, e.g. :func:`~.flexbuild.link_body`) with frames named for the joints it carries:
+    ``crank_body`` frames ``A`` and ``B``, ``coupler_body`` ``B`` and ``C``, ``rocker_body``
+    ``D`` and ``C``. A given body's frames must be its link's length apart (±1 %, undeformed;
+    the kinematics then use the body's own distance), and its own mass properties replace
+    ``masses``, ``inertias`` and ``com_fractions`` for that link. The crank is driven at its
+    ``A`` frame.
 
     Parameters
     ----------
@@ -306,25 +369,42 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
     com_fractions : 3 floats
         Centre of mass of each link as a fraction of its length from A, B, D respectively.
     extra_rocker_inertia : float
-        Inertia rigidly attached to the rocker about D (e.g. sley and sword), kg m^2.
+        Inertia rigidly attached to the rocker about D (e.g. sley and sword), kg m^2. It is
+        added to the rocker's moment about its centre of mass (its mass taken as centred on the
+        fixed pivot D, so only its inertia acts); on a flexible rocker it is added to ``J₀``,
+        i.e. it turns with the rocker's mean axes, not with the D interface alone.
     branch : {1, -1}
         Assembly mode (which side of BD the joint C lies on).
     direction : {1, -1}
         Sense of rotation of the crank (1 counter-clockwise).
+    crank_body, coupler_body, rocker_body : body, optional
+        The link as a given body (see above).
+
+    Raises
+    ------
+    ParameterError
+        A given body lacks its joint frames, or they are not its link's length apart.
     """
     omega = direction * speed_rpm * 2.0 * np.pi / 60.0
     baumgarte = max(50.0, 2.0 * abs(omega)) if baumgarte is None else baumgarte
     D = np.asarray(rocker_pivot, float)
     ground = Ground(frames={"A": (0.0, 0.0), "D": (D[0], D[1])})
-    l1, l2, l3 = crank_length, coupler_length, rocker_length
+    lengths = {"crank": crank_length, "coupler": coupler_length, "rocker": rocker_length}
+    given = {"crank": crank_body, "coupler": coupler_body, "rocker": rocker_body}
+    for role, body in given.items():
+        if body is not None:
+            lengths[role] = _link_length(body, role, lengths[role])
+    l1, l2, l3 = lengths["crank"], lengths["coupler"], lengths["rocker"]
     f1, f2, f3 = com_fractions
-    crank = RigidBody("crank", masses[0], max(inertias[0], 1e-12),
-                      {"A": (-f1 * l1, 0.0), "B": ((1 - f1) * l1, 0.0)})
-    coupler = RigidBody("coupler", masses[1], inertias[1],
-                        {"B": (-f2 * l2, 0.0), "C": ((1 - f2) * l2, 0.0)})
-    m3 = masses[2]
-    i3 = inertias[2] + extra_rocker_inertia
-    rocker = RigidBody("rocker", m3, i3, {"D": (-f3 * l3, 0.0), "C": ((1 - f3) * l3, 0.0)})
+    crank = crank_body or RigidBody("crank", masses[0], max(inertias[0], 1e-12),
+                                    {"A": (-f1 * l1, 0.0), "B": ((1 - f1) * l1, 0.0)})
+    coupler = coupler_body or RigidBody("coupler", masses[1], inertias[1],
+                                        {"B": (-f2 * l2, 0.0), "C": ((1 - f2) * l2, 0.0)})
+    if rocker_body is None:
+        rocker = RigidBody("rocker", masses[2], inertias[2] + extra_rocker_inertia,
+                           {"D": (-f3 * l3, 0.0), "C": ((1 - f3) * l3, 0.0)})
+    else:
+        rocker = _with_extra_inertia(rocker_body, extra_rocker_inertia)
     B = l1 * _unit(theta0)
     BD = D - B
     dist = np.hypot(*BD)
@@ -334,12 +414,22 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
     y = branch * np.sqrt(l2**2 - x**2)
     ebd = BD / dist
     C = B + x * ebd + y * np.array([-ebd[1], ebd[0]])
-    phi2 = np.arctan2(*(C - B)[::-1])
-    phi3 = np.arctan2(*(C - D)[::-1])
-    q0 = np.array([*(f1 * B), theta0, *(B + f2 * (C - B)), phi2, *(D + f3 * (C - D)), phi3])
+    A0 = np.zeros(2)
+    qs = [_place(crank, "A", "B", A0, B), _place(coupler, "B", "C", B, C),
+          _place(rocker, "D", "C", D, C)]
+    if crank_body is not None:
+        turn = float(crank.frame_pose(qs[0], "A")[2] - theta0)
+        if abs(np.angle(np.exp(1j * turn))) > 1e-9:
+            from ..errors import ParameterError
+
+            raise ParameterError("crank_body", "its A frame's angle must be the crank angle "
+                                 "(body x axis from A towards B, no angle offset at A); it is "
+                                 f"{np.rad2deg(turn):.4g} deg off")
+    q0 = np.concatenate(qs)
     rw = omega if ramp_time <= 0.0 else 0.0
-    qd0 = np.zeros(9)
-    qd0[2] = rw
+    qd0 = np.zeros(len(q0))
+    # rigid rotation of the crank about A at rw: v = rw e_z x (position of its frame origin)
+    qd0[:3] = [-qs[0][1] * rw, qs[0][0] * rw, rw]
     pins = [Revolute("A", crank, "A", ground, "A"), Revolute("B", crank, "B", coupler, "B"),
             Revolute("C", rocker, "C", coupler, "C"), Revolute("D", rocker, "D", ground, "D")]
     angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque, "A")

@@ -159,6 +159,10 @@ FLEXIBLE = {
                    "flexible with the defaults)"),
     "rods": Field("table", {}, "every rod as a flexible body (absent: rigid; rods = {} flexible "
                   "with the defaults)"),
+    "coupler": Field("table", {}, "four-bar: the coupler B-C as a flexible body (absent: rigid): "
+                     "file = \"...npz\" or bar = [width, thickness]"),
+    "rocker": Field("table", {}, "four-bar: the rocker D-C as a flexible body (absent: rigid): "
+                    "file = \"...npz\" or bar = [width, thickness]"),
     "start": Field("str", "quasi_static", "initial elastic state: quasi_static (the bodies "
                    "deformed at rest under the loads at t = 0) or undeformed",
                    choices=("quasi_static", "undeformed")),
@@ -186,13 +190,69 @@ FLEX_BODY = {
 
 DEFAULT_MESH_SIZE = {"crank": 0.016, "rods": 0.010}
 
+#: four-bar links (``[dynamics.flexible]`` keys ``crank``, ``coupler``, ``rocker`` with
+#: ``mechanism = "four_bar"``): from a file, or a prismatic bar between the pins reduced here
+LINK_BODY = {
+    "file": Field("str", None, "a crankmodal-flexbody .npz (relative to the scene) with the two "
+                  "interfaces carrying the link's joints"),
+    "bar": Field("floats", None, "[width in the plane, thickness], m: a prismatic bar of the "
+                 "link's length between the pins (at its end faces) reduced here and cached",
+                 length=2, gt=0.0),
+    "interfaces": Field("strs", None, "the file's two interfaces carrying the link's joints, in "
+                        "order: crank A, B; coupler B, C; rocker D, C (default: the file's two "
+                        "interfaces in stored order)", length=2),
+    "n_modes": FLEX_BODY["n_modes"],
+    "cutoff_hz": FLEX_BODY["cutoff_hz"],
+    "damping_ratio": FLEX_BODY["damping_ratio"],
+    "material": Field("str", "steel", "library material of the bar reduced here"),
+    "mesh_size": Field("float", None, "element edge of the bar reduced here, m (default: a "
+                       "quarter of its smaller section side)", gt=0.0),
+    "element_order": FLEX_BODY["element_order"],
+    "fixed_interface_modes": FLEX_BODY["fixed_interface_modes"],
+}
+FOUR_BAR_LINKS = ("crank", "coupler", "rocker")
+CRANK_TRAIN_BODIES = ("crank", "rods")
 
-def validate_flexible(raw: dict) -> dict:
-    """``[dynamics.flexible]``: validated ``crank`` and ``rods`` tables, or None for rigid."""
+
+def flexible_keys(p) -> list[str]:
+    """The ``[dynamics.flexible]`` bodies given (validated parameters)."""
+    return [k for k in ("crank", "rods", "coupler", "rocker") if p["flexible"].get(k) is not None]
+
+
+def _validate_link(key: str, raw: dict) -> dict:
+    where = f"dynamics.flexible.{key}"
+    b = validate(where, raw, LINK_BODY)
+    if (b["file"] is None) == (b["bar"] is None):
+        raise SceneError(f"{where}: give file = \"...npz\" (a reduced link) or bar = [width, "
+                         "thickness] (m, a bar reduced here); the four-bar has no part of its own")
+    if b["n_modes"] is not None and b["cutoff_hz"] is not None:
+        raise SceneError(f"{where}.cutoff_hz: give either n_modes or cutoff_hz, not both")
+    if b["bar"] is not None:
+        if b["interfaces"] is not None:
+            raise SceneError(f"{where}.interfaces: a bar reduced here has its joints at its end "
+                             "faces; interfaces goes with file")
+        if b["mesh_size"] is None:
+            b["mesh_size"] = min(b["bar"]) / 4.0
+    elif b["interfaces"] is not None and b["interfaces"][0] == b["interfaces"][1]:
+        raise SceneError(f"{where}.interfaces: two different interfaces are needed, got "
+                         f"{b['interfaces'][0]!r} twice")
+    return b
+
+
+def validate_flexible(raw: dict, mechanism: str = "slider_crank") -> dict:
+    """``[dynamics.flexible]``: validated body tables (crank trains: ``crank``, ``rods``;
+    the four-bar: ``crank``, ``coupler``, ``rocker``), None for a rigid one."""
     f = validate("dynamics.flexible", raw, FLEXIBLE)
-    for key in ("crank", "rods"):
+    allowed = FOUR_BAR_LINKS if mechanism == "four_bar" else CRANK_TRAIN_BODIES
+    for key in ("crank", "rods", "coupler", "rocker"):
         if not raw.get(key) and key not in raw:
             f[key] = None
+            continue
+        if key not in allowed:
+            raise SceneError(f"dynamics.flexible.{key}: a {mechanism} has no {key}; its "
+                             f"flexible bodies are {', '.join(allowed)}")
+        if mechanism == "four_bar":
+            f[key] = _validate_link(key, f[key])
             continue
         b = validate(f"dynamics.flexible.{key}", f[key], FLEX_BODY)
         if b["n_modes"] is not None and b["cutoff_hz"] is not None:
@@ -214,7 +274,7 @@ def validate_section(raw: dict) -> dict:
     p["contact"] = validate("dynamics.contact", p["contact"], CONTACT)
     p["friction"] = validate("dynamics.friction", p["friction"], FRICTION)
     p["solver"] = validate("dynamics.solver", p["solver"], SOLVER)
-    p["flexible"] = validate_flexible(p["flexible"])
+    p["flexible"] = validate_flexible(p["flexible"], p["mechanism"])
     _cross_checks(p)
     return p
 
@@ -300,14 +360,9 @@ def _cross_checks(p):
     if p["drive_torque"] is not None and p["mechanism"] != "four_bar" and ct["crank_inertia"] <= 0:
         raise SceneError("dynamics.crank_train.crank_inertia: must be > 0 (crank and flywheel, "
                          "kg m^2) when drive_torque sets the speed free")
-    flex = p["flexible"]
-    if flex["crank"] is not None or flex["rods"] is not None:
-        if p["mechanism"] == "four_bar":
-            raise SceneError("dynamics.flexible: flexible bodies go into crank trains "
-                             "(slider_crank, four_star); the four-bar's links are rigid here")
-        if flex["crank"] is not None and p["drive_torque"] is not None:
-            raise SceneError("dynamics.drive_torque: with a flexible crank the speed is "
-                             "prescribed (the part carries no flywheel); remove drive_torque")
+    if p["flexible"]["crank"] is not None and p["drive_torque"] is not None:
+        raise SceneError("dynamics.drive_torque: with a flexible crank the speed is "
+                         "prescribed (the part carries no flywheel); remove drive_torque")
     if p["drive_torque"] is not None and p["ramp_time"] > 0:
         raise SceneError("dynamics.ramp_time: must be 0 with drive_torque (the torque drives)")
     if p["ramp_time"] >= p["end_time"] and p["ramp_time"] > 0:

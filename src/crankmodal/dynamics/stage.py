@@ -18,17 +18,17 @@ def validate(raw: dict, scene) -> dict:
     from pathlib import Path
 
     from ..errors import SceneError
-    from .scene_keys import check_speed, validate_section
+    from .scene_keys import check_speed, flexible_keys, validate_section
 
     p = validate_section(raw)
-    for key in ("crank", "rods"):
+    for key in flexible_keys(p):
         spec = p["flexible"][key]
-        if spec is not None and spec["file"] is not None:
+        if spec["file"] is not None:
             path = scene.resolve(spec["file"]) if scene is not None else Path(spec["file"])
             if not path.is_file():
                 raise SceneError(f"dynamics.flexible.{key}.file: no file {str(path)!r}")
             spec["file"] = str(path)
-            _probe_flexbody(key, spec)
+            _probe_flexbody(key, spec, p)
     if p["from_mechanism"] and (scene is None or "mechanism" not in scene.sections):
         raise SceneError("dynamics.from_mechanism: needs a [mechanism] section in the scene")
     if p["speed_rpm"] is not None:
@@ -80,15 +80,24 @@ def _start_warning(mech, p, rev_hz) -> str | None:
             f"'quasi_static'")
 
 
-def _probe_flexbody(key: str, spec: dict) -> None:
-    """Read a given flexbody file before any stage runs: format, version, modes asked."""
+def _probe_flexbody(key: str, spec: dict, p=None) -> None:
+    """Read a given flexbody file before any stage runs: format, version, modes asked (and for
+    a four-bar link its interfaces and their distance)."""
     from ..errors import InputFileError, SceneError
     from .flexible import load_flexible_body
 
     try:
+        if p is not None and p["mechanism"] == "four_bar":
+            from .flexbuild import link_body
+            from .flexstage import link_length
+
+            link_body(spec["file"], spec, link_length(p, key), key)
+            return
         load_flexible_body(spec["file"], key, n_modes=spec["n_modes"], cutoff_hz=spec["cutoff_hz"],
                            damping_ratio=spec["damping_ratio"])
     except (SceneError, InputFileError) as exc:
+        if str(exc).startswith("dynamics."):
+            raise
         raise type(exc)(f"dynamics.flexible.{key}: {exc}") from None
 
 
@@ -143,7 +152,9 @@ def run(params: dict, ctx) -> dict:
 
     p = params
     bodies = None
-    if p["flexible"]["crank"] is not None or p["flexible"]["rods"] is not None:
+    from .scene_keys import flexible_keys
+
+    if flexible_keys(p):
         from .flexstage import make_bodies
 
         bodies = make_bodies(p, ctx.params.get("mechanism"))
