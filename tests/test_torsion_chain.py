@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from crankmodal.errors import SceneError
+from crankmodal.errors import ParameterError, SceneError
 from crankmodal.torsion import (
     TorsionalChain,
     exact_modes,
@@ -132,15 +132,34 @@ def test_two_rotor_reduction_lumps_rest_at_its_inertia_weighted_position():
 
 
 @pytest.mark.parametrize(
-    "inertias, stiffnesses, fixed, key",
+    "inertias, stiffnesses, fixed, message",
     [
-        ([0.3, -0.6, 0.18], [1e5, 1e5], False, "torsion.inertias[1]"),
-        ([0.3, 0.6, 0.18], [1e5, 0.0], False, "torsion.stiffnesses[1]"),
-        ([0.3, 0.6, 0.18], [1e5], False, "torsion.stiffnesses"),
-        ([0.3, 0.6], [1e5], True, "torsion.stiffnesses"),
-        ([0.3], [], False, "torsion.inertias"),
+        ([0.3, -0.6, 0.18], [1e5, 1e5], False, "inertias[1]: must be > 0 and finite, got -0.6"),
+        ([0.3, 0.6, 0.18], [1e5, 0.0], False, "stiffnesses[1]: must be > 0 and finite, got 0.0"),
+        ([0.3, 0.6, 0.18], [1e5], False,
+         "stiffnesses: needs 2 entries for 3 inertias (free at both ends), got 1"),
+        ([0.3, 0.6], [1e5], True,
+         "stiffnesses: needs 2 entries for 2 inertias (fixed end: wall spring first), got 1"),
+        ([0.3], [], False, "inertias: a free-free chain needs at least 2 rotors, got 1"),
     ],
 )
-def test_bad_chain_raises_scene_error_naming_key(inertias, stiffnesses, fixed, key):
-    with pytest.raises(SceneError, match=key.replace("[", r"\[").replace("]", r"\]")):
+def test_bad_chain_raises_parameter_error_naming_the_argument(inertias, stiffnesses, fixed,
+                                                              message):
+    """The core names its argument (issue 20); the [torsion] stage adds the scene key
+    (test_torsion_scene). Before: SceneError 'torsion.inertias[1]: ...' from the core."""
+    with pytest.raises(ParameterError) as info:
         TorsionalChain(inertias, stiffnesses, fixed_end=fixed)
+    assert not isinstance(info.value, SceneError)
+    assert str(info.value) == message
+    assert info.value.argument == message.split(":")[0]
+
+
+def test_bad_lengths_and_two_rotor_flywheel_name_their_arguments():
+    with pytest.raises(ParameterError, match=r"^lengths: need 1 positive lengths$"):
+        TorsionalChain([0.3, 0.6], [1e5], lengths=[-0.1])
+    chain = TorsionalChain([0.3, 0.6], [1e5])
+    assert not hasattr(chain, "key")  # the core knows no scene key
+    with pytest.raises(ParameterError) as info:
+        reduce_to_two_rotors(chain, "middle")
+    assert not isinstance(info.value, SceneError) and info.value.argument == "flywheel"
+    assert str(info.value) == "flywheel: must be auto, first or last; got 'middle'"

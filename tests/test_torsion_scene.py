@@ -84,6 +84,50 @@ def test_bad_torsion_input_raises_scene_error_naming_key(table, key):
         check(scene_from_dict({"torsion": table}, name="bad"))
 
 
+@pytest.mark.parametrize(
+    "table, message",
+    [
+        ({"inertias": [0.3, 0.6, 0.1], "stiffnesses": [1e5]},
+         "torsion.stiffnesses: needs 2 entries for 3 inertias (free at both ends), got 1"),
+        ({"inertias": [0.3], "stiffnesses": [1e5]},
+         "torsion.inertias: a free-free chain needs at least 2 rotors, got 1"),
+        ({"inertias": [0.3, 0.6], "stiffnesses": [1e5], "max_order": 0.4},
+         "torsion.max_order: must be >= 1 for compressor, got 0.4"),
+    ],
+)
+def test_the_stage_names_the_scene_key_of_a_core_parameter_error(table, message):
+    """The chain and the orders raise ParameterError by argument; the stage re-raises it under
+    the scene key with the same text (issue 20)."""
+    with pytest.raises(SceneError) as info:
+        check(scene_from_dict({"torsion": table}, name="bad"))
+    assert str(info.value) == message
+
+
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("two_rotor_flywheel", "middle",
+         "torsion.two_rotor_flywheel: must be auto, first or last; got 'middle'"),
+        ("operating_speed_rpm", -3.0, "torsion.operating_speed_rpm: must be > 0, got -3.0"),
+    ],
+)
+def test_the_stage_maps_core_arguments_to_their_scene_keys(tmp_path, key, value, message):
+    """reduce_to_two_rotors(flywheel=) and critical_speeds(operating_rpm=) are named by their
+    scene keys when the stage calls them (the schema refuses these values first in a scene; here
+    the validated table is altered to reach the core)."""
+    from crankmodal.runner import StageContext
+    from crankmodal.scene import Scene
+    from crankmodal.torsion import stage
+
+    scene = Scene(name="t", base_dir=Path("."))
+    p = stage.validate({"inertias": [0.3, 0.6], "stiffnesses": [1e5],
+                        "speed_range_rpm": [0.0, 3000.0]}, scene)
+    p[key] = value
+    with pytest.raises(SceneError) as info:
+        stage.run(p, StageContext(scene=scene, out_dir=tmp_path, figures=False))
+    assert str(info.value) == message
+
+
 def test_cli_bad_chain_exits_2_with_one_line_and_no_results(tmp_path, cli):
     out = tmp_path / "out"
     p = cli("run", SCENES / "torsion_chain.toml", "--out", out, "--set", "torsion.inertias=[0.3, 0.0, 0.18]")

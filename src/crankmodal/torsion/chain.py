@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NumericalError, SceneError
+from ..errors import NumericalError, ParameterError
 
 
 @dataclass
@@ -34,8 +34,13 @@ class TorsionalChain:
         positions are then given in m from the start of the chain.
     labels : list of str
         Rotor names (``"rotor 1"``... by default).
-    key : str
-        Scene key prefix used in error messages.
+
+    Raises
+    ------
+    ParameterError
+        Naming the argument (``inertias``, ``inertias[i]``, ``stiffnesses``, ``stiffnesses[i]``,
+        ``lengths``): too few rotors, an entry not > 0 and finite, the wrong number of springs or
+        lengths. The ``[torsion]`` stage re-raises it under its scene key (``torsion.inertias[1]``).
     """
 
     inertias: np.ndarray
@@ -43,7 +48,6 @@ class TorsionalChain:
     fixed_end: bool = False
     lengths: np.ndarray | None = None
     labels: list = field(default_factory=list)
-    key: str = "torsion"
 
     def __post_init__(self):
         self.inertias = np.atleast_1d(np.asarray(self.inertias, float))
@@ -51,24 +55,24 @@ class TorsionalChain:
         n = len(self.inertias)
         need = n if self.fixed_end else n - 1
         if n < (1 if self.fixed_end else 2):
-            raise SceneError(
-                f"{self.key}.inertias: a {'fixed-free' if self.fixed_end else 'free-free'} chain "
+            raise ParameterError(
+                "inertias", f"a {'fixed-free' if self.fixed_end else 'free-free'} chain "
                 f"needs at least {1 if self.fixed_end else 2} rotors, got {n}"
             )
         for name, arr in (("inertias", self.inertias), ("stiffnesses", self.stiffnesses)):
             for i, v in enumerate(arr):
                 if not (np.isfinite(v) and v > 0.0):
-                    raise SceneError(f"{self.key}.{name}[{i}]: must be > 0 and finite, got {float(v)!r}")
+                    raise ParameterError(f"{name}[{i}]", f"must be > 0 and finite, got {float(v)!r}")
         if len(self.stiffnesses) != need:
-            raise SceneError(
-                f"{self.key}.stiffnesses: needs {need} entries for {n} inertias "
+            raise ParameterError(
+                "stiffnesses", f"needs {need} entries for {n} inertias "
                 f"({'fixed end: wall spring first' if self.fixed_end else 'free at both ends'}), "
                 f"got {len(self.stiffnesses)}"
             )
         if self.lengths is not None:
             self.lengths = np.asarray(self.lengths, float)
             if self.lengths.shape != self.stiffnesses.shape or np.any(self.lengths <= 0):
-                raise SceneError(f"{self.key}.lengths: need {need} positive lengths")
+                raise ParameterError("lengths", f"need {need} positive lengths")
         if not self.labels:
             self.labels = [f"rotor {i + 1}" for i in range(n)]
 

@@ -91,7 +91,6 @@ def crank_model(
     n_throws: int = 1,
     form: str = "seed004",
     reference_diameter: float | None = None,
-    key: str = "torsion",
 ) -> CrankModel:
     """Build the chain of ``n_throws`` identical throws and a flywheel.
 
@@ -137,6 +136,5 @@ def crank_model(
         stiffnesses=[k] * n_throws,
         lengths=[l_eq] * n_throws,
         labels=[f"throw {i + 1}" for i in range(n_throws)] + ["flywheel"],
-        key=key,
     )
     return CrankModel(l_eq, d_ref, j_ref, k, parts, i_throw, i_fly, chain)

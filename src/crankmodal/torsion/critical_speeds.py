@@ -14,19 +14,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import ParameterError
 
 #: Order families by machine type.
 ORDER_TYPES = ("compressor", "two_stroke", "four_stroke")
 
 
 def excitation_orders(order_type: str, max_order: float) -> np.ndarray:
-    """Orders up to ``max_order``: integers, or halves for ``four_stroke``."""
+    """Orders up to ``max_order``: integers, or halves for ``four_stroke``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``order_type`` (not one of :data:`ORDER_TYPES`) or ``max_order`` (below the
+        first order).
+    """
     if order_type not in ORDER_TYPES:
-        raise SceneError(f"torsion.order_type: must be one of {', '.join(ORDER_TYPES)}; got {order_type!r}")
+        raise ParameterError("order_type", f"must be one of {', '.join(ORDER_TYPES)}; got {order_type!r}")
     step = 0.5 if order_type == "four_stroke" else 1.0
     if not max_order >= step:
-        raise SceneError(f"torsion.max_order: must be >= {step:g} for {order_type}, got {max_order!r}")
+        raise ParameterError("max_order", f"must be >= {step:g} for {order_type}, got {max_order!r}")
     return np.arange(1, int(np.floor(max_order / step)) + 1) * step
 
 
@@ -131,14 +138,16 @@ def critical_speeds(
 
     Raises
     ------
-    SceneError
-        On an empty speed range or a non-positive operating speed (the message names the key).
+    ParameterError
+        Naming ``speed_range_rpm`` (empty), ``operating_rpm`` (not > 0), ``order_type`` or
+        ``max_order``; the ``[torsion]`` stage re-raises it under its scene key
+        (``torsion.operating_speed_rpm``).
     """
     lo, hi = (float(v) for v in speed_range_rpm)
     if not (0.0 <= lo < hi):
-        raise SceneError(f"torsion.speed_range_rpm: need 0 <= min < max, got [{lo:g}, {hi:g}]")
+        raise ParameterError("speed_range_rpm", f"need 0 <= min < max, got [{lo:g}, {hi:g}]")
     if operating_rpm is not None and not operating_rpm > 0.0:
-        raise SceneError(f"torsion.operating_speed_rpm: must be > 0, got {operating_rpm!r}")
+        raise ParameterError("operating_rpm", f"must be > 0, got {operating_rpm!r}")
     return CriticalSpeeds(
         natural_hz=np.sort(np.asarray(natural_hz, float)),
         orders=excitation_orders(order_type, max_order),

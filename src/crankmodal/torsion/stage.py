@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NumericalError, SceneError
+from ..errors import NumericalError, SceneError, scene_keys
 from ..schema import Field
 from ..schema import validate as validate_table
 from .critical_speeds import ORDER_TYPES
@@ -126,8 +126,9 @@ def build(p: dict):
 
     mode = p["mode"]
     if mode == "geometry":
-        model = crank_model(p["throw"], p["flywheel"], p["G"], p["density"], p["n_throws"],
-                            p["equivalent_length_form"], p["reference_diameter"])
+        with scene_keys(SECTION):  # the chain's own check of the computed inertias/stiffnesses
+            model = crank_model(p["throw"], p["flywheel"], p["G"], p["density"], p["n_throws"],
+                                p["equivalent_length_form"], p["reference_diameter"])
         return model.chain, model
     lengths = None
     if mode == "segments":
@@ -143,7 +144,9 @@ def build(p: dict):
     labels = p["labels"] or []
     if labels and len(labels) != len(p["inertias"]):
         raise SceneError(f"torsion.labels: needs {len(p['inertias'])} names, got {len(labels)}")
-    chain = TorsionalChain(p["inertias"], stiff, fixed_end=p["fixed_end"], lengths=lengths, labels=list(labels))
+    with scene_keys(SECTION):
+        chain = TorsionalChain(p["inertias"], stiff, fixed_end=p["fixed_end"], lengths=lengths,
+                               labels=list(labels))
     return chain, None
 
 
@@ -174,7 +177,8 @@ def validate(raw: dict, scene) -> dict:
         p["speed_range_rpm"] = [0.0, 1.25 * p["operating_speed_rpm"]]
     from .critical_speeds import excitation_orders
 
-    excitation_orders(p["order_type"], p["max_order"])
+    with scene_keys(SECTION):
+        excitation_orders(p["order_type"], p["max_order"])
     build(p)
     return p
 
@@ -196,11 +200,14 @@ def run(p: dict, ctx) -> dict:
             f"torsion: Holzer and eigen solution differ by {rel.max():.1e} (relative); the chain's "
             "inertias/stiffnesses span too many decades"
         )
-    two = reduce_to_two_rotors(chain, p["two_rotor_flywheel"])
+    with scene_keys(SECTION, {"flywheel": "two_rotor_flywheel"}):
+        two = reduce_to_two_rotors(chain, p["two_rotor_flywheel"])
     crit = None
     if p["speed_range_rpm"] is not None:
-        crit = critical_speeds(exact.frequencies_hz, p["order_type"], p["max_order"],
-                               p["speed_range_rpm"], p["operating_speed_rpm"], p["required_margin"])
+        with scene_keys(SECTION, {"operating_rpm": "operating_speed_rpm"}):
+            crit = critical_speeds(exact.frequencies_hz, p["order_type"], p["max_order"],
+                                   p["speed_range_rpm"], p["operating_speed_rpm"],
+                                   p["required_margin"])
 
     out = ctx.out_dir
     text = "\n\n".join(hz.table_text(m) for m in range(len(hz.frequencies_hz)))

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import ParameterError
 from .chain import TorsionalChain
 
 
@@ -112,6 +112,12 @@ def reduce_to_two_rotors(chain: TorsionalChain, flywheel: str = "auto") -> TwoRo
     -------
     TwoRotorResult or None
         None for a chain with a fixed end (no two-rotor equivalent).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``flywheel`` when it is not ``auto``, ``first`` or ``last`` (the ``[torsion]``
+        stage reads it from ``torsion.two_rotor_flywheel``).
     """
     if chain.fixed_end:
         return None
@@ -121,7 +127,7 @@ def reduce_to_two_rotors(chain: TorsionalChain, flywheel: str = "auto") -> TwoRo
     elif flywheel in ("first", "last"):
         a = 0 if flywheel == "first" else len(inertias) - 1
     else:
-        raise SceneError(f"{chain.key}.two_rotor_flywheel: must be auto, first or last; got {flywheel!r}")
+        raise ParameterError("flywheel", f"must be auto, first or last; got {flywheel!r}")
     compliance = np.concatenate([[0.0], np.cumsum(1.0 / chain.stiffnesses)])
     rest = np.arange(len(inertias)) != a
     i_b = inertias[rest].sum()
