@@ -5,7 +5,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from crankmodal.errors import SceneError
+from crankmodal.errors import ParameterError, SceneError
 from crankmodal.fem.assembly import assemble, rigid_body_modes
 from crankmodal.fem.materials import Material
 from crankmodal.fem.modal import solve_modes
@@ -209,9 +209,10 @@ def test_a_cutoff_beyond_the_most_modes_kept_is_refused_not_truncated(bar_model)
     part, model = bar_model
     itf = _ends(part, "rigid")
     f10 = craig_bampton(model, itf, n_modes=10).fixed_interface_hz[-1]
-    with pytest.raises(SceneError, match=r"reduction.cutoff_hz: 10 fixed-interface modes .* "
-                                         r"reach only [\d.]+ Hz, below the cut-off"):
+    with pytest.raises(ParameterError, match=r"^cutoff_hz: 10 fixed-interface modes .* "
+                                             r"reach only [\d.]+ Hz, below the cut-off") as info:
         craig_bampton(model, itf, cutoff_hz=2 * f10, max_modes=10)
+    assert not isinstance(info.value, SceneError)  # the core names its argument (issue 20)
     assert craig_bampton(model, itf, cutoff_hz=0.999 * f10, max_modes=10).n_fixed_modes == 9
 
 
@@ -250,3 +251,21 @@ def test_fixed_interface_modes_bring_back_the_partner_of_an_exactly_repeated_pai
     lam, X = _fixed_interface_modes(sp.identity(n, format="csr"), Diagonal(), n, 3)
     np.testing.assert_allclose(np.sort(lam), [1, 1, 2], rtol=1e-10)
     np.testing.assert_allclose(X.T @ X, np.eye(3), atol=1e-10)
+
+
+def test_craig_bampton_names_its_arguments():
+    """Core errors name the argument (issue 20; the [reduction] stage's scene keys:
+    test_reduction_stress_io_stage). Before: SceneError 'reduction.n_modes: ...'."""
+    part = bar(0.2, 0.02, 0.02, (4, 1, 1), order=1)
+    model = assemble(part, STEEL)
+    itf = _ends(part, "rigid")
+    cases = [((model, []), {"n_modes": 2}, "interfaces: at least one interface is needed"),
+             ((model, itf), {"n_modes": 2, "cutoff_hz": 10.0},
+              "cutoff_hz: give exactly one of n_modes or cutoff_hz"),
+             ((model, itf), {}, "cutoff_hz: give exactly one of n_modes or cutoff_hz"),
+             ((model, itf), {"n_modes": 40}, "n_modes: 40 modes need a finer mesh (36 interior DOFs)")]
+    for args, kwargs, message in cases:
+        with pytest.raises(ParameterError) as info:
+            craig_bampton(*args, **kwargs)
+        assert not isinstance(info.value, SceneError)
+        assert str(info.value) == message and info.value.argument == message.split(":")[0]

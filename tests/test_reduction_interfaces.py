@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from crankmodal.errors import SceneError
+from crankmodal.errors import ParameterError, SceneError
 from crankmodal.fem.assembly import assemble, rigid_body_modes
 from crankmodal.fem.materials import Material
 from crankmodal.fem.testparts import bar, tube
@@ -146,13 +146,20 @@ def test_split_region_makes_disjoint_bands_with_their_own_centres(ring):
     assert set(bands[0].nodes) | set(bands[1].nodes) == set(part.regions["bore"].nodes)
 
 
-def test_bad_interfaces_name_the_key():
+def test_bad_interfaces_name_the_argument():
+    """make_interfaces names its argument (interfaces[i].region/kind), not a scene key (issue
+    20; the [reduction] stage's key: test_reduction_stress_io_stage). Before: SceneError
+    'reduction.interfaces[0].region: ...' from the core."""
     part = bar(0.2, 0.02, 0.02, (4, 1, 1), order=1)
-    with pytest.raises(SceneError, match=r"interfaces\[0\].region: no region 'nope'"):
+    with pytest.raises(ParameterError) as info:
         make_interfaces(part, [{"region": "nope"}])
-    with pytest.raises(SceneError, match=r"interfaces\[1\].kind"):
+    assert not isinstance(info.value, SceneError) and info.value.argument == "interfaces[0].region"
+    assert str(info.value).startswith("interfaces[0].region: no region 'nope' in part")
+    with pytest.raises(ParameterError) as info:
         make_interfaces(part, [{"region": "end_x0"}, {"region": "end_x1", "kind": "glued"}])
-    with pytest.raises(SceneError, match="inside interface"):
+    assert str(info.value) == "interfaces[1].kind: must be one of rigid, distributing; got 'glued'"
+    with pytest.raises(ParameterError, match=r"^interfaces\[1\]\.region: 'end_x0' lies inside "
+                                             r"interface 'end_x0'; interfaces must not overlap$"):
         make_interfaces(part, [{"region": "end_x0"}, {"region": "end_x0"}])
 
 

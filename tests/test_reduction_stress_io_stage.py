@@ -125,3 +125,30 @@ def test_stage_validation_names_the_key(tmp_path):
     p = stage.validate({"interfaces": [{"region": "nope"}]}, sc)
     with pytest.raises(SceneError, match=r"interfaces\[0\].region: no region 'nope'"):
         stage.run(p, part_context(bar(0.2, 0.02, 0.02, (4, 1, 1), order=1), STEEL, tmp_path))
+
+
+def test_the_stage_names_the_scene_key_of_a_core_parameter_error(tmp_path):
+    """make_interfaces and craig_bampton name their arguments; the stage re-raises under the
+    scene key with the same text (issue 20). A region cut into segments gives one spec per band,
+    so the scene's interfaces[1] is make_interfaces' interfaces[2] here (before: the message said
+    reduction.interfaces[2], a table the scene does not have)."""
+    sc = Scene(name="t", base_dir=Path(tmp_path))
+    small = part_context(bar(0.2, 0.02, 0.02, (4, 1, 1), order=1), STEEL, tmp_path)
+    p = stage.validate({"interfaces": [{"region": "end_x0"}, {"region": "end_x1"}],
+                        "n_modes": 40, "compare_full": False}, sc)
+    with pytest.raises(SceneError) as info:
+        stage.run(p, small)
+    assert str(info.value) == "reduction.n_modes: 40 modes need a finer mesh (36 interior DOFs)"
+    p = stage.validate({"interfaces": [{"region": "end_x0"}, {"region": "end_x0"}]}, sc)
+    with pytest.raises(SceneError) as info:
+        stage.run(p, small)
+    assert str(info.value) == ("reduction.interfaces[1].region: 'end_x0' lies inside interface "
+                               "'end_x0'; interfaces must not overlap")
+    ring = part_context(tube(0.02, 0.04, 0.05, divisions=(1, 16, 2), order=1), STEEL, tmp_path)
+    p = stage.validate({"interfaces": [{"region": "bore", "segments": 2},
+                                       {"region": "bore_seg2"}, {"region": "outer"}]}, sc)
+    p["interfaces"][1]["region"] = "bore"  # the stage checks the scene's names first
+    with pytest.raises(SceneError) as info:
+        stage.run(p, ring)
+    assert str(info.value) == ("reduction.interfaces[1].region: 'bore' lies inside interface "
+                               "'bore_seg1'; interfaces must not overlap")

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import NumericalError, SceneError
+from ..errors import NumericalError, ParameterError
 from .interfaces import Interface, distributing_rows, rigid_map
 
 
@@ -260,15 +260,24 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
     Returns
     -------
     CraigBamptonBasis
+
+    Raises
+    ------
+    ParameterError
+        Naming ``interfaces`` (none given), ``cutoff_hz`` (given with ``n_modes``, or neither;
+        a cut-off beyond ``max_modes`` modes), ``n_modes`` (more than the interior DOFs allow)
+        or ``backend``; the ``[reduction]`` stage re-raises it under its scene key.
+    NumericalError
+        The interior stiffness cannot be factorised (a mechanism, inverted elements).
     """
     from ..fem.assembly import rigid_body_modes
     from ..fem.modal import sort_and_normalise
     from ..fem.solvers import factorize_submatrix
 
     if not interfaces:
-        raise SceneError("reduction.interfaces: at least one interface is needed")
+        raise ParameterError("interfaces", "at least one interface is needed")
     if (n_modes is None) == (cutoff_hz is None):
-        raise SceneError("reduction: give exactly one of n_modes or cutoff_hz")
+        raise ParameterError("cutoff_hz", "give exactly one of n_modes or cutoff_hz")
     from ..progress import PhaseTimings
 
     timings = PhaseTimings("reduction: Craig–Bampton", 5)
@@ -317,15 +326,15 @@ def craig_bampton(model, interfaces: list[Interface], n_modes: int | None = None
                 break
             k = min(2 * k, max_modes, n_free - 2)
         if f.max() <= cutoff_hz and k < n_free - 2:  # stopped at max_modes, not at the cut-off
-            raise SceneError(f"reduction.cutoff_hz: {k} fixed-interface modes (the most kept) "
-                             f"reach only {f.max():.6g} Hz, below the cut-off {cutoff_hz:g} Hz; "
-                             f"lower cutoff_hz or give n_modes")
+            raise ParameterError("cutoff_hz", f"{k} fixed-interface modes (the most kept) reach "
+                                              f"only {f.max():.6g} Hz, below the cut-off "
+                                              f"{cutoff_hz:g} Hz; lower cutoff_hz or give n_modes")
         keep = f <= cutoff_hz
         lam, X = lam[keep], X[:, keep]
     elif n_modes > 0:
         if n_modes >= n_free - 1:
-            raise SceneError(f"reduction.n_modes: {n_modes} modes need a finer mesh "
-                             f"({n_free} interior DOFs)")
+            raise ParameterError("n_modes", f"{n_modes} modes need a finer mesh "
+                                            f"({n_free} interior DOFs)")
         lam, X = _fixed_interface_modes(M_II, solver, len(I), n_modes)
     else:
         lam, X = np.zeros(0), np.zeros((len(I), 0))

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import SceneError
+from ..errors import ParameterError
 from ..fem.loads import facet_quadrature
 from ..topology import facet_midnodes
 
@@ -143,8 +143,10 @@ def make_interfaces(part, specs, cells: np.ndarray | None = None) -> list[Interf
 
     Raises
     ------
-    SceneError
-        Unknown region or kind, or a region wholly inside an earlier interface.
+    ParameterError
+        Naming ``interfaces[i].kind`` (unknown kind) or ``interfaces[i].region`` (unknown
+        region, no facets, or wholly inside an earlier interface); ``i`` indexes ``specs``. The
+        ``[reduction]`` stage re-raises it under the scene key ``reduction.interfaces[i]...``.
     """
     points = np.asarray(part.mesh.points, float)[:, :3]
     if cells is None:
@@ -153,21 +155,22 @@ def make_interfaces(part, specs, cells: np.ndarray | None = None) -> list[Interf
     seen: dict[int, str] = {}
     for i, spec in enumerate(specs):
         name, kind = spec["region"], spec.get("kind", "rigid")
-        key = f"reduction.interfaces[{i}]"
+        key = f"interfaces[{i}]"
         if kind not in KINDS:
-            raise SceneError(f"{key}.kind: must be one of {', '.join(KINDS)}; got {kind!r}")
+            raise ParameterError(f"{key}.kind", f"must be one of {', '.join(KINDS)}; got {kind!r}")
         region = spec.get("region_object") or part.regions.get(name)
         if region is None:
             known = ", ".join(sorted(part.regions)) or "none"
-            raise SceneError(f"{key}.region: no region {name!r} in part {part.name!r}; "
-                             f"regions: {known}")
+            raise ParameterError(f"{key}.region", f"no region {name!r} in part {part.name!r}; "
+                                                  f"regions: {known}")
         if len(region.facets) == 0:
-            raise SceneError(f"{key}.region: region {name!r} has no facets")
+            raise ParameterError(f"{key}.region", f"region {name!r} has no facets")
         nodes = np.asarray(region.nodes, np.int64)
         shared = np.fromiter((n in seen for n in nodes.tolist()), bool, len(nodes))
         if shared.all():
-            raise SceneError(f"{key}.region: {name!r} lies inside interface "
-                             f"{seen[int(nodes[0])]!r}; interfaces must not overlap")
+            raise ParameterError(f"{key}.region", f"{name!r} lies inside interface "
+                                                  f"{seen[int(nodes[0])]!r}; interfaces must not "
+                                                  f"overlap")
         nodes = nodes[~shared]  # a node on a common boundary line belongs to the first interface
         seen.update(dict.fromkeys(nodes.tolist(), name))
         c, a, r, src = interface_centre(points, region, cells)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 import time
 
-from ..errors import SceneError
+from ..errors import SceneError, scene_keys
 from ..schema import Field
 from ..schema import validate as validate_table
 
@@ -99,6 +99,21 @@ def interface_specs(part, p: dict) -> list[dict]:
     return out
 
 
+def interface_keys(p: dict) -> dict:
+    """Scene keys of :func:`make_interfaces`' arguments for the specs of :func:`interface_specs`.
+
+    A region split into ``segments`` bands gives that many specs, so the ``i``-th spec is not
+    always the scene's ``interfaces[i]``: ``{"interfaces[j].region": "interfaces[i].region"}``.
+    """
+    keys, j = {}, 0
+    for i, s in enumerate(p["interfaces"]):
+        for _ in range(s.get("segments", 1)):
+            for name in ("region", "kind"):
+                keys[f"interfaces[{j}].{name}"] = f"interfaces[{i}].{name}"
+            j += 1
+    return keys
+
+
 def run(p: dict, ctx) -> dict:
     import numpy as np
 
@@ -112,14 +127,15 @@ def run(p: dict, ctx) -> dict:
     part, mat = part_and_material(ctx, SECTION)
     with PeakMemory() as mem:
         model, t_asm = timed_fe_model(ctx, part, mat)
-        itf = make_interfaces(part, interface_specs(part, p))
-        body, cb = reduce_body(model, itf, n_modes=p["n_modes"], cutoff_hz=p["cutoff_hz"],
-                               backend=p["backend"], mesh=part.mesh, stress=p["stress_modes"],
-                               name=part.name, info={"part": part.name, "material": mat.name})
+        with scene_keys(SECTION, interface_keys(p)):
+            itf = make_interfaces(part, interface_specs(part, p))
+        with scene_keys(SECTION):
+            body, cb = reduce_body(model, itf, n_modes=p["n_modes"], cutoff_hz=p["cutoff_hz"],
+                                   backend=p["backend"], mesh=part.mesh, stress=p["stress_modes"],
+                                   name=part.name, info={"part": part.name, "material": mat.name})
         timings = {"assembly_s": t_asm, **body.info["timings_s"]}
         full = None
         if p["compare_full"]:
-            from ..errors import scene_keys
             from ..fem.modal import solve_modes
 
             t0 = time.perf_counter()
