@@ -234,7 +234,8 @@ def _scene(tmp_path, flexible: dict, mechanism_lines=()):
 def test_scene_runs_a_flexible_coupler_and_rocker_against_the_rigid_twin(bars, tmp_path):
     """`crankmodal run` on the loom with a flexible coupler from a file and a flexible rocker
     reduced here as a bar: results name both bodies, their joints' interfaces and the
-    comparison with the rigid twin at A (the "main bearing") and at B, C and D."""
+    comparison with the rigid twin at A (the "main bearing") and at B, C and D, and the
+    flexible rocker's angular acceleration."""
     import json
 
     from conftest import run_in_process
@@ -253,6 +254,10 @@ def test_scene_runs_a_flexible_coupler_and_rocker_against_the_rigid_twin(bars, t
     assert set(d["rigid"]) == {"main_bearing", "B", "C", "D"}
     assert d["rigid"]["C"]["rigid_peak_n"] > 100.0
     assert "bar_" in d["files"]["rocker"]
+    # the flexible rocker's swing (its frame, the mean axes) is reported as a rigid one's
+    dyn = next(v for v in _walk(res) if isinstance(v, dict) and "angular_acceleration_peak" in v)
+    assert dyn["angular_acceleration_peak"]["rocker"] > 100.0  # rad/s^2
+    assert "rocker accel peak 0 " not in dyn["summary"]
 
 
 def _walk(d):

@@ -41,7 +41,8 @@ class History:
     constraint_drift : (K,) max |Phi|, m or rad.
     onsets : dict joint -> [(t, v_impact)] contact onsets (s, m/s), every zero crossing.
     separations : dict joint -> [t] contact separations, s.
-    angular_acceleration : dict body name -> (K,) rad/s^2 (e.g. the loom's rocker and sley).
+    angular_acceleration : dict body name -> (K,) rad/s^2 (e.g. the loom's rocker and sley; a
+        flexible body's: of its frame, the mean axes).
     peaks : dict joint -> dict of arrays at the deepest penetration of each contact (located as
         events, not sampled): ``t`` (s), ``fn`` (N), ``penetration`` (m), ``main_bearing_force``
         (magnitude, N) and ``piston_acceleration`` (n, P) (m/s^2) at that instant.
@@ -162,7 +163,8 @@ def record(mech, sysm, integ) -> History:
     torque = np.zeros(K)
     energy = {k: np.zeros(K) for k in ("kinetic", "potential", "contact_elastic")}
     drift = np.zeros(K)
-    alpha = {b.name: np.zeros(K) for b in sysm.bodies if b.ndof == 3}
+    # every body's frame (a flexible body's mean axes, e.g. the four-bar's flexible rocker)
+    alpha = {b.name: np.zeros(K) for b in sysm.bodies}
     elastic = bool(getattr(sysm, "_elastic", ()))
     if elastic:
         energy["strain"] = np.zeros(K)
