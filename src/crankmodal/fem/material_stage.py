@@ -6,7 +6,7 @@ Puts the :class:`~crankmodal.fem.materials.Material` in ``ctx.products["material
 
 from __future__ import annotations
 
-from ..errors import SceneError
+from ..errors import SceneError, scene_keys
 from ..schema import Field
 from ..schema import validate as validate_table
 
@@ -28,7 +28,8 @@ def validate(raw: dict, scene) -> dict:
 
     p = validate_table(SECTION, raw, SCHEMA)
     if p["name"] is not None:
-        material(p["name"])  # unknown name -> SceneError naming it
+        with scene_keys(SECTION):  # unknown name -> material.name: ...
+            material(p["name"])
     else:
         missing = [k for k in ("E", "nu", "rho") if p[k] is None]
         if missing:
@@ -45,10 +46,11 @@ def make_material(p: dict):
 
     over = {k: p[k] for k in ("E", "nu", "rho", "yield_strength", "ultimate_strength")
             if p.get(k) is not None}
-    if p.get("name"):
-        base = material(p["name"])
-        return replace(base, **over) if over else base
-    return Material(name="custom", **over)
+    with scene_keys(SECTION):  # the Material's own checks, named by their scene keys
+        if p.get("name"):
+            base = material(p["name"])
+            return replace(base, **over) if over else base
+        return Material(name="custom", **over)
 
 
 def run(p: dict, ctx) -> dict:

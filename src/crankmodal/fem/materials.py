@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-from ..errors import SceneError
+from ..errors import ParameterError
 
 LIBRARY = Path(__file__).with_name("materials.toml")
 
@@ -33,6 +33,13 @@ class Material:
     yield_strength, ultimate_strength : float or None
         Pa; safety factors need them.
     description : str
+
+    Raises
+    ------
+    ParameterError
+        Naming the argument (``E``, ``nu``, ``rho``, ``yield_strength``,
+        ``ultimate_strength``) out of its range; the ``[material]`` stage re-raises it as
+        ``material.<key>``.
     """
 
     name: str
@@ -50,11 +57,11 @@ class Material:
             ("rho", self.rho, self.rho > 0, "> 0 kg/m^3"),
         ):
             if not ok:
-                raise SceneError(f"material.{key}: must be {text}, got {value!r} ({self.name})")
+                raise ParameterError(key, f"must be {text}, got {value!r} ({self.name})")
         for key in ("yield_strength", "ultimate_strength"):
             v = getattr(self, key)
             if v is not None and not v > 0:
-                raise SceneError(f"material.{key}: must be > 0 Pa, got {v!r} ({self.name})")
+                raise ParameterError(key, f"must be > 0 Pa, got {v!r} ({self.name})")
 
     @property
     def lame(self) -> tuple[float, float]:
@@ -92,12 +99,13 @@ def material(name: str) -> Material:
 
     Raises
     ------
-    SceneError
-        If the name is not in the library; the message lists the known names.
+    ParameterError
+        Naming ``name`` if it is not in the library; the message lists the known names (the
+        ``[material]`` stage re-raises it as ``material.name``).
     """
     lib = library()
     by_lower = {k.lower(): k for k in lib}
     key = by_lower.get(str(name).strip().lower())
     if key is None:
-        raise SceneError(f"material.name: unknown material {name!r}; known: {', '.join(lib)}")
+        raise ParameterError("name", f"unknown material {name!r}; known: {', '.join(lib)}")
     return Material(name=key, **lib[key])

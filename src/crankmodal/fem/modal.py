@@ -212,8 +212,8 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
     ------
     ParameterError
         ``n_modes`` below 1 or above the elastic DOF, ``shift`` not negative, ``eigensolver``
-        unknown, Lanczos asked for nearly every pair, or ``supports`` holding every node in
-        every direction (the message names the argument; a stage
+        unknown, Lanczos asked for nearly every pair, ``supports`` holding every node in
+        every direction, or ``backend`` unknown or not installed (the message names the argument; a stage
         re-raises it under its scene key with :class:`crankmodal.errors.scene_keys`).
     NumericalError
         The pairs fail their checks, or the rigid-body count is not the expected one.

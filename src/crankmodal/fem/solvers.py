@@ -27,7 +27,7 @@ import os
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import ResourceError, SceneError
+from ..errors import ParameterError, ResourceError
 
 BACKENDS = ("auto", "pardiso", "superlu")
 
@@ -75,15 +75,22 @@ def available_backends() -> list[str]:
 
 
 def resolve_backend(backend: str) -> str:
-    """The concrete backend ``auto`` stands for; checks an explicit one is installed."""
+    """The concrete backend ``auto`` stands for; checks an explicit one is installed.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``backend``: unknown, or not installed here. A stage re-raises it under its scene
+        key (``modal.backend``).
+    """
     if backend not in BACKENDS:
-        raise SceneError(f"backend: must be one of {', '.join(BACKENDS)}; got {backend!r}")
+        raise ParameterError("backend", f"must be one of {', '.join(BACKENDS)}; got {backend!r}")
     have = available_backends()
     if backend == "auto":
         return have[0]
     if backend not in have:
-        raise SceneError(f"backend: {backend!r} is not installed (pip install pypardiso); "
-                         f"available: {', '.join(have)}")
+        raise ParameterError("backend", f"{backend!r} is not installed (pip install pypardiso); "
+                                        f"available: {', '.join(have)}")
     return backend
 
 

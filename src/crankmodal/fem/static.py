@@ -141,7 +141,7 @@ def solve_static(model: FEModel, mesh, load: Load | list | np.ndarray, supports:
     ParameterError
         Naming ``supports`` if they leave a mechanism (with how many rigid-body modes remain),
         hold every node in every direction or are not :class:`Support` objects, ``load`` if it
-        is not a load of this mesh.
+        is not a load of this mesh, ``backend`` if it is unknown or not installed.
     """
     from ..progress import PhaseTimings
     from .modal import expected_rigid_modes
