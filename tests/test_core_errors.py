@@ -89,3 +89,62 @@ def test_the_static_stage_names_the_scene_key_of_a_backend_not_installed(tmp_pat
         static_stage.run(p, ctx)
     assert str(info.value) == ("static.backend: 'pardiso' is not installed (pip install "
                                "pypardiso); available: superlu")
+
+
+# --- mesh size ----------------------------------------------------------------------------------
+
+def test_the_element_count_refusal_names_size_and_the_geometry_stage_its_scene_key():
+    """check_size (build_part, import_cad) and check_size_floor (the stage's check) named
+    'geometry.mesh_size' from the core; now 'size', and the stage words it as before."""
+    import pickle
+
+    from crankmodal.errors import ResourceError
+    from crankmodal.geometry.mesh import MeshSettings, MeshSizeError, check_size, check_size_floor
+    from crankmodal.geometry.params import params_from_dict
+    from crankmodal.resources import load_machine
+
+    settings = MeshSettings(size=1e-4, max_elements=5e6, limit_reason="the limit")
+    with pytest.raises(ParameterError) as info:
+        check_size(1.037e-3, 0.1035, settings)
+    exc = info.value
+    assert isinstance(exc, MeshSizeError) and isinstance(exc, ResourceError)
+    assert not isinstance(exc, SceneError) and exc.argument == "size"
+    # 8.5 V/h^3 + 17.5 A/h^2 = 8.8e9 + 0.18e9
+    assert str(exc) == ("size: 0.0001 m makes about 9e+09 tetrahedra (V = 1037 cm3, "
+                        "A = 1035 cm2), over the limit of 5e+06 (the limit); use size >= 0.0013 m")
+    assert exc.worded("geometry.mesh_size", "geometry.params.") == (
+        "geometry.mesh_size = 0.0001 m: about 9e+09 tetrahedra (V = 1037 cm3, A = 1035 cm2), "
+        "over the limit of 5e+06 (the limit); use mesh_size >= 0.0013 m")
+    assert str(pickle.loads(pickle.dumps(exc))) == str(exc)  # a study's worker raises it
+
+    rod = params_from_dict("rod", load_machine("four_star_compressor")["rod"], where="rod")
+    with pytest.raises(MeshSizeError) as info:
+        check_size_floor(rod, settings)
+    assert str(info.value).startswith("size: 0.0001 m makes at least 3.1e+08 tetrahedra (6 V/h^3, "
+                                      "V >= 51.35 cm3, most of it the big end: "
+                                      "big_end_outer_diameter = 0.075 m, big_end_width = 0.015 m)")
+    assert info.value.worded("geometry.mesh_size", "geometry.params.").startswith(
+        "geometry.mesh_size = 0.0001 m: at least 3.1e+08 tetrahedra (6 V/h^3, V >= 51.35 cm3, "
+        "most of it the big end: geometry.params.big_end_outer_diameter = 0.075 m, "
+        "geometry.params.big_end_width = 0.015 m), over the limit of 5e+06 (the limit); "
+        "use mesh_size >= ")
+
+
+def test_the_geometry_stage_refuses_the_mesh_size_in_its_scene_words(tmp_path, monkeypatch):
+    from crankmodal.errors import ResourceError
+    from crankmodal.geometry import build, stage
+    from crankmodal.scene import scene_from_dict
+
+    raw = {"machine": "four_star_compressor", "part": "rod", "mesh_size": 1e-4}
+    with pytest.raises(SceneError, match=r"^geometry\.mesh_size = 0\.0001 m: at least 3\.1e\+08 "
+                                         r"tetrahedra .* geometry\.params\.big_end_width = "):
+        stage.validate(raw, scene_from_dict({"geometry": raw}, name="t"))
+    # the closer estimate on the CAD solid, before gmsh meshes (build_part's check_size)
+    monkeypatch.setattr(build, "generate", lambda *a, **k: pytest.fail("meshed"))
+    raw = {**raw, "mesh_size": 0.01, "cache": False}
+    p = stage.validate(raw, scene_from_dict({"geometry": raw}, name="t"))
+    monkeypatch.setattr(stage, "mesh_settings", lambda p: build.MeshSettings(  # above the floor
+        size=p["mesh_size"], order=1, max_elements=1000, limit_reason="a thousand"))
+    with pytest.raises(ResourceError, match=r"^geometry\.mesh_size = 0\.01 m: about [\d.e+]+ "
+                                            r"tetrahedra \(V = .*\(a thousand\); use mesh_size >= "):
+        stage.make_part(p)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import GeometryError
+from ..errors import GeometryError, ParameterError, ResourceError
 
 #: gmsh tetra10 -> meshio/VTK tetra10 node order (the last two edge nodes swap).
 GMSH_TO_MESHIO_TET10 = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 8])
@@ -105,6 +105,52 @@ def size_for_elements(volume: float, area: float, n_elements: float) -> float:
     return hi
 
 
+class MeshSizeError(ParameterError, ResourceError):
+    """A mesh ``size`` (:class:`MeshSettings`) that makes more tetrahedra than the limit.
+
+    A :class:`~crankmodal.errors.ParameterError` naming ``size`` (and a
+    :class:`~crankmodal.errors.ResourceError`, what :func:`check_size` raised before)::
+
+        size: 0.0001 m makes about 8.8e+09 tetrahedra (V = 1037 cm3, A = 1035 cm2), over the
+        limit of 5e+06 (crankmodal's limit on the mesh size); use size >= 0.0012 m
+
+    :meth:`worded` says the same with the names a scene gives the size and the part's
+    parameters (the ``[geometry]`` stage: ``geometry.mesh_size = 0.0001 m: about ...``).
+
+    Attributes
+    ----------
+    size, smallest : float
+        The size refused and the smallest the limit allows, m.
+    count : float
+        The estimate (``about``) or lower bound (``at least``) of the tetrahedra.
+    """
+
+    def __init__(self, size: float, bound: str, count: float, basis: str, limit: float,
+                 reason: str, smallest: float, feature: str = "", dims: dict | None = None):
+        self.size, self.bound, self.count, self.basis = size, bound, count, basis
+        self.limit, self.reason, self.smallest = limit, reason, smallest
+        self.feature, self.dims = feature, dict(dims or {})
+        super().__init__("size", self._body(" makes", "", "size"))
+
+    def __reduce__(self):  # picklable (a study's workers raise it in another process)
+        return (MeshSizeError, (self.size, self.bound, self.count, self.basis, self.limit,
+                                self.reason, self.smallest, self.feature, self.dims))
+
+    def _body(self, verb: str, prefix: str, size_name: str) -> str:
+        most = ""
+        if self.feature:
+            dims = ", ".join(f"{prefix}{k} = {x:g} m" for k, x in self.dims.items())
+            most = f", most of it the {self.feature}: {dims}"
+        return (f"{self.size:g} m{verb} {self.bound} {self.count:.2g} tetrahedra ({self.basis}"
+                f"{most}), over the limit of {self.limit:.2g} ({self.reason}); use "
+                f"{size_name} >= {self.smallest:.2g} m")
+
+    def worded(self, size_key: str, params_prefix: str = "") -> str:
+        """The message with a scene's names: ``size_key`` (``geometry.mesh_size``) for the size,
+        ``params_prefix`` (``geometry.params.``) before each part parameter named."""
+        return f"{size_key} = " + self._body(":", params_prefix, size_key.rsplit(".", 1)[-1])
+
+
 def check_size(volume: float, area: float, settings: MeshSettings) -> float:
     """Refuse a mesh size whose element count estimate exceeds ``settings.max_elements``.
 
@@ -118,19 +164,16 @@ def check_size(volume: float, area: float, settings: MeshSettings) -> float:
 
     Raises
     ------
-    ResourceError
-        Naming ``geometry.mesh_size``, the estimate, the limit and the smallest size it allows.
+    MeshSizeError
+        Naming ``size``, the estimate, the limit and the smallest size it allows (a
+        ParameterError and a ResourceError).
     """
-    from ..errors import ResourceError
-
     n = estimate_elements(volume, area, settings.size)
     if n > settings.max_elements:
-        h_min = size_for_elements(volume, area, settings.max_elements)
-        raise ResourceError(
-            f"geometry.mesh_size = {settings.size:g} m: about {n:.2g} tetrahedra "
-            f"(V = {volume * 1e6:.4g} cm3, A = {area * 1e4:.4g} cm2), over the limit of "
-            f"{settings.max_elements:.2g} ({settings.limit_reason}); "
-            f"use mesh_size >= {h_min:.2g} m")
+        raise MeshSizeError(settings.size, "about", n,
+                            f"V = {volume * 1e6:.4g} cm3, A = {area * 1e4:.4g} cm2",
+                            settings.max_elements, settings.limit_reason,
+                            size_for_elements(volume, area, settings.max_elements))
     return n
 
 
@@ -185,24 +228,19 @@ def check_size_floor(params, settings: MeshSettings) -> float:
 
     Raises
     ------
-    SceneError
-        Naming ``geometry.mesh_size``, the bound, the feature that holds most of it with its
-        parameters (a huge part is as likely the cause as a tiny size), the limit and the
-        smallest size it allows.
+    MeshSizeError
+        Naming ``size``, the bound, the feature that holds most of it with its parameters (a
+        huge part is as likely the cause as a tiny size), the limit and the smallest size it
+        allows.
     """
-    from ..errors import SceneError
-
     terms = volume_floor_terms(params)
     v = sum(t[1] for t in terms)
     n = ELEMENTS_PER_VOLUME_FLOOR * v / settings.size**3
     if n > settings.max_elements:
         feature, _, keys = max(terms, key=lambda t: t[1])
-        dims = ", ".join(f"geometry.params.{k} = {x:g} m" for k, x in keys.items())
         h_min = (ELEMENTS_PER_VOLUME_FLOOR * v / settings.max_elements) ** (1.0 / 3.0)
-        raise SceneError(
-            f"geometry.mesh_size = {settings.size:g} m: at least {n:.2g} tetrahedra (6 V/h^3, "
-            f"V >= {v * 1e6:.4g} cm3, most of it the {feature}: {dims}), over the limit of "
-            f"{settings.max_elements:.2g} ({settings.limit_reason}); use mesh_size >= {h_min:.2g} m")
+        raise MeshSizeError(settings.size, "at least", n, f"6 V/h^3, V >= {v * 1e6:.4g} cm3",
+                            settings.max_elements, settings.limit_reason, h_min, feature, keys)
     return n
 
 

@@ -104,15 +104,39 @@ def validate(raw: dict, scene) -> dict:
         origin = f" (machine {p['machine']!r}, [{p['part']}])" if p["machine"] else ""
         raise SceneError(text + origin) from None
     p["part_params"] = params
-    from .mesh import check_size_floor
+    from .mesh import MeshSizeError, check_size_floor
 
-    check_size_floor(params, mesh_settings(p))  # run estimates again, closer, on the CAD solid
+    try:  # run estimates again, closer, on the CAD solid
+        check_size_floor(params, mesh_settings(p))
+    except MeshSizeError as exc:
+        raise SceneError(exc.worded("geometry.mesh_size", "geometry.params.")) from None
     return p
 
 
+def _build_or_import(p: dict, settings):
+    """The part of validated parameters ``p``: a CAD file meshed, a mesh file read, or built."""
+    if p["file"] is not None:
+        from .importers import CAD_SUFFIXES, import_cad, import_mesh
+
+        if p["file"].lower().endswith(CAD_SUFFIXES):
+            return import_cad(p["file"], p["region_specs"], settings)
+        return import_mesh(p["file"], p["region_specs"])
+    from .build import build_part
+
+    name = f"{p['machine']}/{p['part']}" if p["machine"] else p["part"]
+    return build_part(p["part_params"], p["fidelity"], settings, name=name)
+
+
 def make_part(p: dict):
-    """Build or import the part of validated parameters ``p``, through the on-disk cache."""
+    """Build or import the part of validated parameters ``p``, through the on-disk cache.
+
+    Raises
+    ------
+    ResourceError
+        A ``mesh_size`` making more tetrahedra than the limit, named ``geometry.mesh_size``.
+    """
     from .cache import file_digest, load_part, part_key, store_part
+    from .mesh import MeshSizeError
 
     settings = mesh_settings(p)
     if p["file"] is not None:
@@ -125,18 +149,12 @@ def make_part(p: dict):
     part = load_part(key) if p["cache"] else None
     cached = part is not None
     if part is None:
-        if p["file"] is not None:
-            from .importers import CAD_SUFFIXES, import_cad, import_mesh
+        try:
+            part = _build_or_import(p, settings)
+        except MeshSizeError as exc:  # the element-count refusal, in the scene's words
+            from ..errors import ResourceError
 
-            if p["file"].lower().endswith(CAD_SUFFIXES):
-                part = import_cad(p["file"], p["region_specs"], settings)
-            else:
-                part = import_mesh(p["file"], p["region_specs"])
-        else:
-            from .build import build_part
-
-            name = f"{p['machine']}/{p['part']}" if p["machine"] else p["part"]
-            part = build_part(p["part_params"], p["fidelity"], settings, name=name)
+            raise ResourceError(exc.worded("geometry.mesh_size", "geometry.params.")) from None
         if p["cache"]:
             try:
                 store_part(key, part)
