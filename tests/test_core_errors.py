@@ -148,3 +148,19 @@ def test_the_geometry_stage_refuses_the_mesh_size_in_its_scene_words(tmp_path, m
     with pytest.raises(ResourceError, match=r"^geometry\.mesh_size = 0\.01 m: about [\d.e+]+ "
                                             r"tetrahedra \(V = .*\(a thousand\); use mesh_size >= "):
         stage.make_part(p)
+
+
+def test_a_study_model_refuses_the_mesh_size_in_the_scene_words(tmp_path, monkeypatch):
+    """The report study builds its parts with build_part: its refusal reads as before
+    ('geometry.mesh_size = ...'), not the core's 'size: ...'."""
+    from crankmodal.errors import ResourceError
+    from crankmodal.geometry import build, stage
+    from crankmodal.report.study_scene import solve_model
+    from crankmodal.scene import scene_from_dict
+
+    monkeypatch.setattr(build, "generate", lambda *a, **k: pytest.fail("meshed"))
+    raw = {"machine": "four_star_compressor", "part": "rod", "mesh_size": 0.01}
+    g = stage.validate(raw, scene_from_dict({"geometry": raw}, name="t"))
+    with pytest.raises(ResourceError, match=r"^geometry\.mesh_size = 0\.0001 m: about [\d.e+]+ "
+                                            r"tetrahedra \(V = .*; use mesh_size >= "):
+        solve_model(tmp_path, g, {}, {"name": "steel"}, "simplified", 1e-4, 1, 4)

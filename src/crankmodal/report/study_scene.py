@@ -91,8 +91,15 @@ def solve_model(out_dir, geometry: dict, modal: dict, material, fidelity: str, m
         from ..fem.material_stage import make_material
 
         material = make_material(material)
+    from ..geometry.mesh import MeshSizeError
+
     t0 = time.perf_counter()
-    part = part_builder(geometry)(fidelity, mesh_size, order)
+    try:
+        part = part_builder(geometry)(fidelity, mesh_size, order)
+    except MeshSizeError as exc:  # the core names 'size'; the scene's words, as the stage's
+        from ..errors import ResourceError
+
+        raise ResourceError(exc.worded("geometry.mesh_size", "geometry.params.")) from None
     t1 = time.perf_counter()
     modes = modes_solver(modal, material, n_modes)(part)
     t2 = time.perf_counter()
