@@ -164,3 +164,35 @@ def test_a_study_model_refuses_the_mesh_size_in_the_scene_words(tmp_path, monkey
     with pytest.raises(ResourceError, match=r"^geometry\.mesh_size = 0\.0001 m: about [\d.e+]+ "
                                             r"tetrahedra \(V = .*; use mesh_size >= "):
         solve_model(tmp_path, g, {}, {"name": "steel"}, "simplified", 1e-4, 1, 4)
+
+
+@pytest.mark.parametrize("fidelity, settings, argument, text", [
+    ("coarse", {"size": 0.01}, "fidelity",
+     "must be one of full, dechamfered, simplified; got 'coarse'"),
+    ("full", {"size": 0.0}, "size", "must be > 0 m, got 0.0"),
+    ("full", {"size": 0.01, "order": 3}, "order", "must be 1 or 2, got 3"),
+    ("full", {"size": 0.01, "refine": 1.5}, "refine", "must be in (0, 1], got 1.5"),
+])
+def test_build_part_names_its_argument(fidelity, settings, argument, text):
+    """Before: GeometryError 'geometry.fidelity: ...', 'geometry.mesh_size: ...' from the core."""
+    from crankmodal.geometry.build import build_part
+    from crankmodal.geometry.mesh import MeshSettings
+    from crankmodal.geometry.params import params_from_dict
+    from crankmodal.resources import load_machine
+
+    rod = params_from_dict("rod", load_machine("four_star_compressor")["rod"], where="rod")
+    _core(lambda: build_part(rod, fidelity, MeshSettings(**settings)), argument, text)
+
+
+def test_the_geometry_stage_names_the_scene_key_of_a_mesh_setting(monkeypatch):
+    """The schema refuses these first in a scene; settings that skipped it still read as the
+    scene's keys (geometry.element_order)."""
+    from crankmodal.geometry import build, stage
+    from crankmodal.scene import scene_from_dict
+
+    raw = {"machine": "four_star_compressor", "part": "rod", "cache": False}
+    p = stage.validate(raw, scene_from_dict({"geometry": raw}, name="t"))
+    monkeypatch.setattr(stage, "mesh_settings", lambda p: build.MeshSettings(size=0.01, order=3))
+    with pytest.raises(SceneError) as info:
+        stage.make_part(p)
+    assert str(info.value) == "geometry.element_order: must be 1 or 2, got 3"

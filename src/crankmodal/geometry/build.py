@@ -12,14 +12,16 @@ from .session import gmsh_session, quiet_stdout
 
 
 def _check_settings(settings: MeshSettings) -> None:
-    from ..errors import GeometryError
+    """Refuse MeshSettings out of range with a ParameterError naming the field (``size``,
+    ``order``, ``refine``)."""
+    from ..errors import ParameterError
 
     if not settings.size > 0:
-        raise GeometryError(f"geometry.mesh_size: must be > 0 m, got {settings.size!r}")
+        raise ParameterError("size", f"must be > 0 m, got {settings.size!r}")
     if settings.order not in (1, 2):
-        raise GeometryError(f"geometry.element_order: must be 1 or 2, got {settings.order!r}")
+        raise ParameterError("order", f"must be 1 or 2, got {settings.order!r}")
     if not 0 < settings.refine <= 1:
-        raise GeometryError(f"geometry.refine: must be in (0, 1], got {settings.refine!r}")
+        raise ParameterError("refine", f"must be in (0, 1], got {settings.refine!r}")
 
 
 def mesh_tagged(gmsh, volumes: list, specs: list, settings: MeshSettings, refined=()):
@@ -64,6 +66,15 @@ def build_part(params: CrankshaftParams | ConrodParams, fidelity: str, settings:
     Part
         With regions, CAD mass properties, and in ``quality`` the mesh statistics and the
         mesh-vs-CAD mass-property differences (``mass_check``).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``fidelity`` (unknown) or the settings' ``size``, ``order``, ``refine`` out of
+        range; :class:`~crankmodal.geometry.mesh.MeshSizeError` (naming ``size``) when the size
+        makes more tetrahedra than ``settings.max_elements``.
+    GeometryError
+        Impossible parameters (named ``crankshaft.<name>`` / ``rod.<name>``) or a kernel failure.
     """
     check_fidelity(fidelity)
     _check_settings(settings)

@@ -1,7 +1,8 @@
 """Admissibility of parameter sets, checked before any geometry kernel runs.
 
-Every refusal is a :class:`~crankmodal.errors.GeometryError` with one line naming the parameter,
-its admissible range for the other parameters as given, and the value received, e.g.::
+Every refusal of a part parameter is a :class:`~crankmodal.errors.GeometryError` with one line
+naming the parameter, its admissible range for the other parameters as given, and the value
+received (an unknown fidelity: a ParameterError naming ``fidelity``), e.g.::
 
     crankshaft.web_width: must be >= 0.0735 m (web must hold the pin and its fillet), got 0.06
 
@@ -57,9 +58,12 @@ def _at_most(part: str, name: str, value: float, hi: float, why: str) -> None:
 
 
 def check_fidelity(fidelity: str) -> str:
-    """Return ``fidelity`` if it is one of :data:`FIDELITIES`."""
+    """Return ``fidelity`` if it is one of :data:`FIDELITIES`; else a ParameterError naming
+    ``fidelity``."""
+    from ..errors import ParameterError
+
     if fidelity not in FIDELITIES:
-        raise GeometryError(f"geometry.fidelity: must be one of {', '.join(FIDELITIES)}; got {fidelity!r}")
+        raise ParameterError("fidelity", f"must be one of {', '.join(FIDELITIES)}; got {fidelity!r}")
     return fidelity
 
 

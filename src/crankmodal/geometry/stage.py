@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import time
 
-from ..errors import GeometryError, SceneError
+from ..errors import GeometryError, SceneError, scene_keys
 from ..schema import Field
 from ..schema import validate as validate_table
 
@@ -149,12 +149,13 @@ def make_part(p: dict):
     part = load_part(key) if p["cache"] else None
     cached = part is not None
     if part is None:
-        try:
-            part = _build_or_import(p, settings)
-        except MeshSizeError as exc:  # the element-count refusal, in the scene's words
-            from ..errors import ResourceError
+        with scene_keys(SECTION, {"size": "mesh_size", "order": "element_order"}):
+            try:
+                part = _build_or_import(p, settings)
+            except MeshSizeError as exc:  # the element-count refusal, in the scene's words
+                from ..errors import ResourceError
 
-            raise ResourceError(exc.worded("geometry.mesh_size", "geometry.params.")) from None
+                raise ResourceError(exc.worded("geometry.mesh_size", "geometry.params.")) from None
         if p["cache"]:
             try:
                 store_part(key, part)
