@@ -53,7 +53,8 @@ SCHEMA = {
     "contact": Field("table", {}, "normal contact law and parameters"),
     "friction": Field("table", {}, "friction law and parameters"),
     "solver": Field("table", {}, "integrator settings"),
-    "flexible": Field("table", {}, "flexible (Craig-Bampton) bodies: crank = {...}, rods = {...}"),
+    "flexible": Field("table", {}, "flexible (Craig-Bampton) bodies: crank = {...}, rods = {...} "
+                      "(crank trains); crank, coupler, rocker = {...} (four-bar)"),
     "ensemble": Field("int", 1, "trajectories run from starting states perturbed at round-off "
                       "level (relative 1e-12 k): their spread is the uncertainty of an impacting "
                       "run that one trajectory cannot show", ge=1, le=64),
