@@ -396,10 +396,13 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
             lengths[role] = _link_length(body, role, lengths[role])
     l1, l2, l3 = lengths["crank"], lengths["coupler"], lengths["rocker"]
     f1, f2, f3 = com_fractions
-    crank = crank_body or RigidBody("crank", masses[0], max(inertias[0], 1e-12),
-                                    {"A": (-f1 * l1, 0.0), "B": ((1 - f1) * l1, 0.0)})
-    coupler = coupler_body or RigidBody("coupler", masses[1], inertias[1],
-                                        {"B": (-f2 * l2, 0.0), "C": ((1 - f2) * l2, 0.0)})
+    crank, coupler = crank_body, coupler_body
+    if crank is None:
+        crank = RigidBody("crank", masses[0], max(inertias[0], 1e-12),
+                          {"A": (-f1 * l1, 0.0), "B": ((1 - f1) * l1, 0.0)})
+    if coupler is None:
+        coupler = RigidBody("coupler", masses[1], inertias[1],
+                            {"B": (-f2 * l2, 0.0), "C": ((1 - f2) * l2, 0.0)})
     if rocker_body is None:
         rocker = RigidBody("rocker", masses[2], inertias[2] + extra_rocker_inertia,
                            {"D": (-f3 * l3, 0.0), "C": ((1 - f3) * l3, 0.0)})
