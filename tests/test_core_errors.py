@@ -196,3 +196,15 @@ def test_the_geometry_stage_names_the_scene_key_of_a_mesh_setting(monkeypatch):
     with pytest.raises(SceneError) as info:
         stage.make_part(p)
     assert str(info.value) == "geometry.element_order: must be 1 or 2, got 3"
+
+
+def test_a_parameter_error_survives_pickling():
+    # a Dask worker sends the exception it raised back to the client
+    import pickle
+
+    from crankmodal.errors import ParameterError
+
+    err = pickle.loads(pickle.dumps(ParameterError("n_modes", "must be >= 1, got 0")))
+    assert type(err) is ParameterError
+    assert (err.argument, err.text, str(err)) == ("n_modes", "must be >= 1, got 0",
+                                                  "n_modes: must be >= 1, got 0")

@@ -76,6 +76,10 @@ class ParameterError(CrankmodalError, ValueError):
         self.text = text
         super().__init__(f"{argument}: {text}")
 
+    def __reduce__(self):
+        # picklable as raised (a Dask worker sends it back to the client)
+        return type(self), (self.argument, self.text)
+
 
 class scene_keys:
     """Re-raise :class:`ParameterError` inside the block as :class:`SceneError` under ``prefix``.
