@@ -143,3 +143,13 @@ def test_a_factor_larger_than_the_memory_is_refused_before_it_is_allocated(monke
     monkeypatch.setenv("CRANKMODAL_MEMORY_LIMIT", str(2 * needed / 1e9))
     assert solvers.factorize(model.K + model.M, "pardiso").memory_needed == needed
 
+
+
+def test_convergence_study_names_a_bad_support_by_argument():
+    from crankmodal.errors import ParameterError
+    from crankmodal.fem import convergence
+    from crankmodal.fem.testparts import bar
+
+    with pytest.raises(ParameterError, match=r"^supports\[0\]\.region: no region 'nope'"):
+        convergence.study(lambda h, o: bar(0.2, 0.02, 0.02, (4, 1, 1), order=o), [0.05],
+                          orders=(1,), material=STEEL, supports=[{"region": "nope"}])

@@ -86,7 +86,8 @@ def study(build, sizes, orders=(1, 2), material=None, n_modes: int = 6, supports
     n_modes : int
         Elastic modes compared (by rank).
     supports : list of dict
-        Scene-style support tables (empty: free-free).
+        Support tables ``{region = ..., fix = ...}`` or ``{box = [...], fix = ...}``, resolved
+        on each mesh (empty: free-free); a bad one raises ParameterError naming ``supports[i]``.
     backend : str
 
     Returns
@@ -96,7 +97,7 @@ def study(build, sizes, orders=(1, 2), material=None, n_modes: int = 6, supports
     from .assembly import assemble
     from .memory import PeakMemory
     from .modal import solve_modes
-    from .supports import select
+    from .supports import select_supports
 
     sizes = sorted(sizes, reverse=True)
     table = ConvergenceTable()
@@ -107,7 +108,7 @@ def study(build, sizes, orders=(1, 2), material=None, n_modes: int = 6, supports
                 t0 = time.perf_counter()
                 part = build(h, order)
                 model = assemble(part, material)
-                modes = solve_modes(model, n_modes, select(part, supports), backend=backend)
+                modes = solve_modes(model, n_modes, select_supports(part, supports), backend=backend)
                 wall = time.perf_counter() - t0
             freqs.append(modes.frequencies_hz[:n_modes])
             rows.append({"order": order, "mesh_size": float(h), "n_dofs": modes.n_dofs,
