@@ -302,6 +302,8 @@ def _walk(d):
     ("neither", "dynamics.flexible.coupler: give file"),
     ("both", "dynamics.flexible.coupler: give file"),
     ("crank_train", "dynamics.flexible.coupler: a slider_crank has no coupler"),
+    ("same_twice", "dynamics.flexible.coupler.interfaces: two different interfaces"),
+    ("crank_torque", "dynamics.drive_torque: with a flexible crank the speed is prescribed"),
 ])
 def test_bad_four_bar_flexible_input_exits_2_naming_the_key(bars, tmp_path, case, match):
     """Every bad four-bar link input through `crankmodal run`: exit 2, one line naming the key,
@@ -320,9 +322,13 @@ def test_bad_four_bar_flexible_input_exits_2_naming_the_key(bars, tmp_path, case
             "rods": {"rods": ok},
             "neither": {"coupler": {"n_modes": 1}},
             "both": {"coupler": dict(ok, bar=[0.01, 0.01])},
-            "crank_train": {"coupler": ok}}[case]
+            "crank_train": {"coupler": ok},
+            "same_twice": {"coupler": dict(ok, interfaces=["end_x0", "end_x0"])},
+            "crank_torque": {"crank": {"bar": [0.02, 0.02]}}}[case]
     if case == "crank_train":
         mech = ('mechanism = "slider_crank"', "speed_rpm = 1000.0")
+    if case == "crank_torque":
+        mech = ("drive_torque = 10.0",)
     out = tmp_path / "out"
     status, err = run_in_process("run", _scene(tmp_path, flex, mech), "--out", out)
     lines = [ln for ln in err.strip().splitlines() if ln.strip() and not ln.startswith("[")]
