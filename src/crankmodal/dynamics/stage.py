@@ -264,6 +264,13 @@ def run(params: dict, ctx) -> dict:
         res["flexible"] = flexible_results(mech, hist, rigid, sel, rev_hz, bodies)
         res["flexible"]["rigid_integration_wall_time_s"] = None if rigid is None else rigid.wall_time
         res["flexible"]["start"] = {"state": p["flexible"]["start"], **(start_info or {})}
+        from .flexstage import flexible_bodies_of
+        from .stepbound import step_bound
+
+        bound = step_bound(flexible_bodies_of(mech), settings.method, t_end, hist.nfev,
+                           key_of=_flexible_key)
+        if bound is not None:
+            res["flexible"]["step_bound"] = bound
     study = None
     if p["solver"]["study_rtols"]:
         rt = sorted(set(p["solver"]["study_rtols"]) | {settings.rtol / 10})
@@ -321,8 +328,17 @@ def run(params: dict, ctx) -> dict:
             res["summary"] += (f"; main bearing flexible vs rigid: peak {cmp['peak_n']:.4g} vs "
                                f"{cmp['rigid_peak_n']:.4g} N, RMS of the difference "
                                f"{100 * cmp['relative_difference_rms']:.2g} % of the rigid RMS")
+        sb = res["flexible"].get("step_bound")
+        if sb and sb["bound"]:
+            res["summary"] += (f"; {sb['method']} steps ({sb['mean_step_s']:.2g} s) bound by the "
+                               f"{sb['frequency_hz']:.4g} Hz mode of {sb['body']}")
     ctx.products[SECTION] = {"mechanism": mech, "history": hist, "ideal": ideal, "rigid": rigid}
     return res
+
+
+def _flexible_key(body_name: str) -> str:
+    """The ``[dynamics.flexible]`` table of a flexible body (for advice)."""
+    return "dynamics.flexible." + ("rods" if body_name.startswith("rod_") else body_name)
 
 
 def _figures(hist, ideal, mech, sel, study, out, spec=None):
