@@ -108,13 +108,15 @@ def test_clearance_at_a_flexible_big_end_runs_with_the_contact_checks(parts):
 
 
 def test_interfaces_at_the_wrong_places_are_refused(parts, tmp_path):
-    from crankmodal.errors import SceneError
+    # the builders name their argument (the scene path, naming dynamics.flexible.<body>.file,
+    # is test_bad_flexible_input_exits_2_with_one_line_naming_the_key)
+    from crankmodal.errors import ParameterError
 
-    with pytest.raises(SceneError, match="crank radius is 0.05"):
+    with pytest.raises(ParameterError, match=r"^source: .*crank radius is 0.05"):
         flexbuild.crank_body(parts.crank, SPEC_CRANK, parts.rows, 0.05)
-    with pytest.raises(SceneError, match="rod length is 0.3 m"):
+    with pytest.raises(ParameterError, match=r"^source: .*rod length is 0.3 m"):
         flexbuild.rod_body(parts.rod, SPEC_ROD, 0.3, "rod_1")
-    with pytest.raises(SceneError, match="needs main_journal_"):
+    with pytest.raises(ParameterError, match=r"^source: .*needs main_journal_"):
         flexbuild.crank_body(parts.rod, SPEC_CRANK, parts.rows, parts.radius)
 
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import ParameterError, SceneError, scene_keys
 
 #: relative tolerance on the crank radius and rod length a reduced body must match
 GEOMETRY_TOLERANCE = 0.01
@@ -123,11 +123,13 @@ def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
     else:
         specs = [{"region": n, "kind": "distributing", "segments": 1}
                  for n in ("big_end_bore", "small_end_bore")]
-    itf = make_interfaces(prt, interface_specs(prt, {"interfaces": specs, "coupling": "distributing"}))
-    t0 = time.perf_counter()
-    body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"], mesh=prt.mesh,
-                          name=prt.name, info={"part": prt.name, "material": mat.name,
-                                               "machine": machine})
+    with scene_keys(where, {"n_modes": "fixed_interface_modes"}):
+        itf = make_interfaces(prt, interface_specs(prt, {"interfaces": specs,
+                                                         "coupling": "distributing"}))
+        t0 = time.perf_counter()
+        body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"], mesh=prt.mesh,
+                              name=prt.name, info={"part": prt.name, "material": mat.name,
+                                                   "machine": machine})
     steps["reduction_s"] = time.perf_counter() - t0
     path.parent.mkdir(parents=True, exist_ok=True)
     save_flexbody(path, body)  # atomic
@@ -182,16 +184,16 @@ def crank_body(source, spec: dict, row_z, crank_radius: float | None, name: str 
     mains = sorted(n for n in centres if n.startswith("main_journal"))
     bands = sorted(n for n in centres if n.startswith("crankpin"))
     if not mains or not bands:
-        raise SceneError(f"dynamics.flexible.crank.file: {path}: needs main_journal_* and "
-                         f"crankpin_* interfaces; has {', '.join(sorted(centres)) or 'none'}")
+        raise ParameterError("source", f"{path}: needs main_journal_* and crankpin_* "
+                             f"interfaces; has {', '.join(sorted(centres)) or 'none'}")
     axis0 = np.mean([centres[n] for n in mains], axis=0)
     pin_mid = np.mean([centres[n] for n in bands], axis=0)
     arm = pin_mid[:2] - axis0[:2]
     r_file = float(np.hypot(*arm))
     if crank_radius is not None and abs(r_file / crank_radius - 1) > GEOMETRY_TOLERANCE:
-        raise SceneError(f"dynamics.flexible.crank.file: {path}: its crankpin is {r_file:.5g} m "
-                         f"from the main journals' axis, the mechanism's crank radius is "
-                         f"{crank_radius:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
+        raise ParameterError("source", f"{path}: its crankpin is {r_file:.5g} m from the main "
+                             f"journals' axis, the mechanism's crank radius is "
+                             f"{crank_radius:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
     pins = []
     for z in row_z:
         dz = [abs(centres[n][2] - pin_mid[2] - z) for n in bands]
@@ -224,14 +226,14 @@ def rod_body(source, spec: dict, rod_length: float | None, name: str, z: float =
     c = _centres(fb)
     for bore in ("big_end_bore", "small_end_bore"):
         if bore not in c:
-            raise SceneError(f"dynamics.flexible.rods.file: {path}: no interface {bore!r}; "
-                             f"interfaces: {', '.join(c) or 'none'}")
+            raise ParameterError("source", f"{path}: no interface {bore!r}; "
+                                 f"interfaces: {', '.join(c) or 'none'}")
     d = c["small_end_bore"][:2] - c["big_end_bore"][:2]
     length = float(np.hypot(*d))
     if rod_length is not None and abs(length / rod_length - 1) > GEOMETRY_TOLERANCE:
-        raise SceneError(f"dynamics.flexible.rods.file: {path}: its bores are {length:.5g} m "
-                         f"apart, the mechanism's rod length is {rod_length:.5g} m "
-                         f"(tolerance {GEOMETRY_TOLERANCE:.0%})")
+        raise ParameterError("source", f"{path}: its bores are {length:.5g} m apart, the "
+                             f"mechanism's rod length is {rod_length:.5g} m "
+                             f"(tolerance {GEOMETRY_TOLERANCE:.0%})")
     body = planar_body(fb, name, n_modes=spec.get("n_modes"), cutoff_hz=spec.get("cutoff_hz"),
                        damping_ratio=spec["damping_ratio"], z=z, orientation=_in_plane_angle(d),
                        path=path)
@@ -278,18 +280,19 @@ def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
     part = bar(length, width, thickness, div, order=spec["element_order"])
     mat = make_material(mp)
     model = assemble(part, mat)
-    itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
-                                 for n in ("end_x0", "end_x1")])
-    body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"], mesh=part.mesh,
-                          name="bar", info={"part": "bar", "material": mat.name,
-                                            "length_m": length, "section_m": [width, thickness]})
+    with scene_keys(key, {"n_modes": "fixed_interface_modes"}):
+        itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
+                                     for n in ("end_x0", "end_x1")])
+        body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"],
+                              mesh=part.mesh, name="bar",
+                              info={"part": "bar", "material": mat.name, "length_m": length,
+                                    "section_m": [width, thickness]})
     path.parent.mkdir(parents=True, exist_ok=True)
     save_flexbody(path, body)  # atomic
     return path
 
 
-def link_body(source, spec: dict, length: float | None, role: str, name: str | None = None,
-              key: str | None = None):
+def link_body(source, spec: dict, length: float | None, role: str, name: str | None = None):
     """A planar flexible four-bar link from a flexbody file (or that body read already).
 
     Parameters
@@ -305,8 +308,6 @@ def link_body(source, spec: dict, length: float | None, role: str, name: str | N
     role : {"crank", "coupler", "rocker"}
     name : str, optional
         Body name (default: ``role``).
-    key : str, optional
-        Scene table named in messages (default ``dynamics.flexible.<role>``).
 
     Returns
     -------
@@ -317,26 +318,25 @@ def link_body(source, spec: dict, length: float | None, role: str, name: str | N
     from .flexible import planar_body
     from .mechanisms import FOUR_BAR_JOINTS
 
-    key = key or f"dynamics.flexible.{role}"
     fb, path = read(source)
     c = _centres(fb)
     names = spec.get("interfaces")
     if names is None:
         if len(c) != 2:
-            raise SceneError(f"{key}.interfaces: {path}: has {len(c)} interfaces "
-                             f"({', '.join(c) or 'none'}); name the two carrying the "
-                             f"{role}'s joints {' and '.join(FOUR_BAR_JOINTS[role])}")
+            raise ParameterError("interfaces", f"{path}: has {len(c)} interfaces "
+                                 f"({', '.join(c) or 'none'}); name the two carrying the "
+                                 f"{role}'s joints {' and '.join(FOUR_BAR_JOINTS[role])}")
         names = list(c)
     for n in names:
         if n not in c:
-            raise SceneError(f"{key}.interfaces: {path}: no interface {n!r}; interfaces: "
-                             f"{', '.join(c) or 'none'}")
+            raise ParameterError("interfaces", f"{path}: no interface {n!r}; interfaces: "
+                                 f"{', '.join(c) or 'none'}")
     d = c[names[1]][:2] - c[names[0]][:2]
     dist = float(np.hypot(*d))
     if length is not None and not abs(dist / length - 1) <= GEOMETRY_TOLERANCE:
-        raise SceneError(f"{key}.file: {path}: its interfaces {names[0]!r} and {names[1]!r} "
-                         f"are {dist:.5g} m apart, the mechanism's {role} length is "
-                         f"{length:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
+        raise ParameterError("source", f"{path}: its interfaces {names[0]!r} and "
+                             f"{names[1]!r} are {dist:.5g} m apart, the mechanism's {role} "
+                             f"length is {length:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
     body = planar_body(fb, name or role, n_modes=spec.get("n_modes"),
                        cutoff_hz=spec.get("cutoff_hz"), damping_ratio=spec["damping_ratio"],
                        orientation=_in_plane_angle(d), path=path)

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
+from ..errors import SceneError, scene_keys
 
 #: output samples processed at once when the stress modes are superposed
 STRESS_CHUNK = 64
@@ -48,6 +48,12 @@ def _file(spec, machine, part, n_rods, key):
     return reduced_part(machine, part, spec, n_rods=n_rods)
 
 
+def body_keys(key: str):
+    """The builders' errors (:mod:`.flexbuild`: ``ParameterError`` naming ``source``,
+    ``interfaces``) re-raised under ``dynamics.flexible.<key>`` (``source`` is its ``file``)."""
+    return scene_keys(f"dynamics.flexible.{key}", {"source": "file"})
+
+
 def link_length(p, role: str) -> float:
     """The four-bar's length of link ``role`` (crank, coupler, rocker), m."""
     from .scene_keys import FOUR_BAR_LINKS
@@ -72,7 +78,8 @@ def make_links(p) -> dict:
         try:
             path = Path(spec["file"]) if spec["file"] is not None else \
                 reduced_bar(length, spec["bar"], spec, key)
-            out["links"][role] = link_body(path, spec, length, role)
+            with body_keys(role):
+                out["links"][role] = link_body(path, spec, length, role)
         except (SceneError, InputFileError) as exc:
             if str(exc).startswith("dynamics."):
                 raise
@@ -104,15 +111,17 @@ def make_bodies(p, mechanism_params=None) -> dict | None:
     try:
         if flex["crank"] is not None:
             path = _file(flex["crank"], machine, "crankshaft", len(rows), "crank")
-            out["crank"] = crank_body(path, flex["crank"], rows, radius)
+            with body_keys("crank"):
+                out["crank"] = crank_body(path, flex["crank"], rows, radius)
             out["files"]["crank"] = str(path)
         key = "rods"
         if flex["rods"] is not None:
             path = _file(flex["rods"], machine, "rod", 1, "rods")
             rod = read(path)[0]  # one reading, a planar body per cylinder
             rod.info["file"] = str(path)
-            out["rods"] = [rod_body(rod, flex["rods"], L, f"rod_{i}", z=z)
-                           for i, (L, z) in enumerate(zip(lengths, rows), start=1)]
+            with body_keys("rods"):
+                out["rods"] = [rod_body(rod, flex["rods"], L, f"rod_{i}", z=z)
+                               for i, (L, z) in enumerate(zip(lengths, rows), start=1)]
             out["files"]["rods"] = str(path)
     except (SceneError, InputFileError) as exc:
         if str(exc).startswith("dynamics."):
@@ -256,5 +265,5 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
     return res
 
 
-__all__ = ["dynamic_stress", "flexible_results", "force_comparison", "interface_deflections",
+__all__ = ["body_keys", "dynamic_stress", "flexible_results", "force_comparison", "interface_deflections",
            "link_length", "make_bodies", "make_links", "rigid_twins", "train_geometry"]

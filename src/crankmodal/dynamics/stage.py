@@ -89,9 +89,10 @@ def _probe_flexbody(key: str, spec: dict, p=None) -> None:
     try:
         if p is not None and p["mechanism"] == "four_bar":
             from .flexbuild import link_body
-            from .flexstage import link_length
+            from .flexstage import body_keys, link_length
 
-            link_body(spec["file"], spec, link_length(p, key), key)
+            with body_keys(key):
+                link_body(spec["file"], spec, link_length(p, key), key)
             return
         load_flexible_body(spec["file"], key, n_modes=spec["n_modes"], cutoff_hz=spec["cutoff_hz"],
                            damping_ratio=spec["damping_ratio"])
