@@ -142,7 +142,9 @@ FRICTION = {
 
 SOLVER = {
     "method": Field("str", "auto", "solve_ivp method; auto: RK45 (fastest measured, also for "
-                    "stiff contact), LSODA when friction sticks (slow sliding)", choices=METHODS),
+                    "stiff contact), LSODA when friction sticks (slow sliding) or with an oil "
+                    "film; with flexible bodies Radau on ideal joints or with an oil film",
+                    choices=METHODS),
     "rtol": Field("float", 1e-6, "relative tolerance", gt=0.0, lt=1.0),
     "atol": Field("float", None, "absolute position tolerance, m (default min(1e-9, c/1e4))",
                   gt=0.0),
