@@ -347,3 +347,51 @@ def test_bad_four_bar_flexible_input_exits_2_naming_the_key(bars, tmp_path, case
     assert len(lines) == 1 and re.search(match, lines[0]), err
     assert "Traceback" not in err
     assert not (out / "results.json").exists()
+
+
+def test_four_bar_figure_draws_joints_a_to_d_flexible_rigid_and_difference(bars, tmp_path,
+                                                                          monkeypatch):
+    """`crankmodal run` with figures on the loom with a flexible coupler: the flexible-vs-rigid
+    figure has one panel per four-bar joint A, B, C, D (none titled "main bearing"), each with
+    the flexible and rigid-twin force magnitudes (kN) and, on a twin axis, |F_flex - F_rigid|
+    (N) equal to that of the arrays in dynamics.npz over the last revolution drawn."""
+    from conftest import run_in_process
+
+    from crankmodal.dynamics import flexplots
+
+    drawn = {}
+    save = flexplots._save
+
+    def spy(plt, fig, path):
+        drawn[path.name] = [(a.get_title(), [(ln.get_label(), ln.get_xydata()) for ln in a.lines])
+                            for a in fig.axes]
+        return save(plt, fig, path)
+
+    monkeypatch.setattr(flexplots, "_save", spy)
+    out = tmp_path / "out"
+    status, err = run_in_process("run", _scene(tmp_path, {"coupler": {"file": str(bars.coupler),
+                                                                      "n_modes": 3}}),
+                                 "--out", out)
+    assert status == 0, err
+    assert (out / "dynamics_flexible_main_bearing.png").stat().st_size > 0
+    axes = drawn["dynamics_flexible_main_bearing.png"]
+    titled = [(t, lines) for t, lines in axes if t]
+    joints = [(t, lines) for t, lines in titled if t.startswith("joint ") and "order" not in t]
+    assert [t.split()[1] for t, _ in joints] == ["A", "B", "C", "D"]
+    assert all("of the four-bar" in t for t, _ in joints)
+    assert not any("main bearing" in t or "main-bearing" in t for t, _ in titled)
+    # the difference curves: the untitled twin axes, one per joint panel, in joint order
+    diffs = [lines for t, lines in axes if not t and lines]
+    assert len(diffs) == 4
+    z = np.load(out / "dynamics.npz")
+    for (title, lines), twin in zip(joints, diffs):
+        j = title.split()[1]
+        (_, flex), (_, rig) = [(n, xy) for n, xy in lines if n in ("flexible", "rigid twin")]
+        (name, dxy), = twin
+        assert name.startswith("|flexible - rigid|")
+        f, g = z[f"joint_force_{j}"], z[f"rigid_joint_force_{j}"]
+        n = flex.shape[0]  # the last samples: the last revolution (here the whole short run)
+        assert np.allclose(flex[:, 1], np.hypot(*f[-n:].T) / 1e3)
+        assert np.allclose(rig[:, 1], np.hypot(*g[-n:].T) / 1e3)
+        assert np.allclose(dxy[:, 1], np.hypot(*(f - g)[-n:].T))
+        assert dxy[:, 1].max() > 0.0  # the flexible coupler differs from its rigid twin

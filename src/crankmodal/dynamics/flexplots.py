@@ -1,5 +1,5 @@
-"""PNG figures of a run with flexible bodies: main-bearing force flexible vs rigid, modal
-coordinates (matplotlib on its own Agg canvas, imported here only)."""
+"""PNG figures of a run with flexible bodies: main-bearing force (a four-bar: joints A-D)
+flexible vs rigid, modal coordinates (matplotlib on its own Agg canvas, imported here only)."""
 
 from __future__ import annotations
 
@@ -10,30 +10,62 @@ import numpy as np
 from ..plotting import pyplot as _plt
 from .plots import _save, last_revolutions
 
+#: what each joint of the four-bar connects (for the panel titles)
+FOUR_BAR_JOINTS = {"A": "crank pivot", "B": "crank-coupler", "C": "coupler-rocker",
+                   "D": "rocker pivot"}
+
+
+def _force_series(hist, rigid, mech) -> list[tuple[str, np.ndarray, np.ndarray | None]]:
+    """The forces drawn: (title, flexible, rigid twin or None), each an (n, 2) array in N.
+
+    A four-bar: its joints A, B, C, D. A crank train: the main-bearing sum, then each main
+    journal when there are several."""
+    if mech.kind == "four_bar":
+        return [(f"joint {j} ({what}) of the four-bar", hist.joint_forces[j],
+                 None if rigid is None else rigid.joint_forces[j])
+                for j, what in FOUR_BAR_JOINTS.items() if j in hist.joint_forces]
+    joints = mech.main_joints if len(mech.main_joints) > 1 else []
+    series = [("main bearing (sum)", hist.main_bearing_force,
+               None if rigid is None else rigid.main_bearing_force)]
+    return series + [(f"journal {j}", hist.joint_forces[j],
+                      None if rigid is None else rigid.joint_forces[j]) for j in joints]
+
 
 def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
-    """Main-bearing force magnitude over the last revolution (flexible solid, rigid dashed),
-    one panel for the sum and one per main journal, and the order amplitudes of the sum."""
+    """Joint forces over the last revolution (flexible solid, rigid twin dashed) and the order
+    amplitudes of the main-bearing force.
+
+    A crank train: one panel for the main-bearing force magnitude (the sum) and one per main
+    journal. A four-bar: one panel per joint A, B, C, D, each with the magnitude of the
+    flexible-minus-rigid force vector on a right-hand axis (N), and the orders of joint A."""
     from .signals import order_amplitudes
 
     plt = _plt()
-    joints = mech.main_joints if len(mech.main_joints) > 1 else []
-    n = 2 + len(joints)
+    four_bar = mech.kind == "four_bar"
+    series = _force_series(hist, rigid, mech)
+    n = 1 + len(series)
     fig, ax = plt.subplots(n, 1, figsize=(9, 2.6 * n))
     last = last_revolutions(hist, 1.0) & sel
     ang = hist.crank_angle[last]  # a coordinate of the run: continuous, no wrap
     deg = np.rad2deg(np.abs(ang - ang[0]))  # turned since the last revolution began
-    series = [("main bearing (sum)", hist.main_bearing_force,
-               None if rigid is None else rigid.main_bearing_force)]
-    series += [(f"journal {j}", hist.joint_forces[j],
-                None if rigid is None else rigid.joint_forces[j]) for j in joints]
     for a, (label, f, fr) in zip(ax, series):
-        a.plot(deg, np.hypot(*f[last].T) / 1e3, lw=1.2, label="flexible")
+        lines = a.plot(deg, np.hypot(*f[last].T) / 1e3, lw=1.2, label="flexible")
         if fr is not None:
-            a.plot(deg, np.hypot(*fr[last].T) / 1e3, "k--", lw=1.0, label="rigid twin")
+            lines += a.plot(deg, np.hypot(*fr[last].T) / 1e3, "k--", lw=1.0, label="rigid twin")
+            if four_bar:
+                b = a.twinx()
+                lines += b.plot(deg, np.hypot(*(f[last] - fr[last]).T), color="tab:red",
+                                lw=0.8, label="|flexible - rigid| (right)")
+                b.set_ylabel("|ΔF| [N]", color="tab:red")
+                b.tick_params(axis="y", colors="tab:red")
+                b.set_ylim(bottom=0.0)
         a.set(xlabel="crank angle in the last revolution [deg]", ylabel="|F| [kN]", title=label)
         a.grid(alpha=0.3)
-        a.legend(loc="upper right", fontsize=8)
+        if four_bar:  # one row at the top middle, clear of the peaks and the ringing
+            a.legend(lines, [ln.get_label() for ln in lines], loc="upper center", fontsize=8,
+                     ncol=len(lines))
+        else:
+            a.legend(loc="upper right", fontsize=8)
     orders = np.arange(13)
     t = hist.t[sel]
     rev = mech.revolution_hz
@@ -45,8 +77,9 @@ def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
             ar = order_amplitudes(t, rigid.main_bearing_force[sel], rev, orders)
             ax[-1].bar(orders + w / 2, np.hypot(ar[:, 0], ar[:, 1]) / 1e3, w, color="0.4",
                        label="rigid twin")
+        what = "joint A (crank pivot)" if four_bar else "main-bearing"
         ax[-1].set(xlabel="order (per revolution)", ylabel="amplitude [kN]",
-                   title="main-bearing force by order (x and y combined)", xticks=orders)
+                   title=f"{what} force by order (x and y combined)", xticks=orders)
         ax[-1].legend(fontsize=8)
     return _save(plt, fig, path)
 
