@@ -13,6 +13,8 @@ load ``F`` (N): ``static_penetration(F)`` (m), ``tangent_stiffness(F)`` (N/m), `
 (its own damping coefficient there, N s/m; 0 for none), ``dashpot_setting`` (the damping
 parameter as set, or None) and ``stiffness_for_tangent(k_target, k_lin)`` (the stiffness
 parameter that would give the tangent stiffness ``k_target`` at the same load).
+``hertz_stiffness`` is ``K`` in N/m**1.5 when the law's elastic force is ``K delta**1.5`` (a
+constant comparable with a steel pair's Hertz stiffness), else None.
 
 Laws whose damping depends on the impact velocity have ``needs_impact_velocity = True``. A
 friction law has ``coefficient(v)``: the signed coefficient at slip velocity ``v`` (m/s), the
@@ -116,6 +118,13 @@ class NormalLaw:
     def dashpot_setting(self) -> float | None:
         """The damping parameter as set (N s/m), or None for a law without a dashpot."""
         return None
+
+    @property
+    def hertz_stiffness(self) -> float | None:
+        """``stiffness`` when the elastic force is ``K delta**1.5``: a Hertz-type constant in
+        N/m**1.5, comparable with a steel pair's :func:`.contact.cylinder_stiffness`; None for
+        another exponent, a linear law or a line contact."""
+        return self.stiffness if self.elastic_exponent == 1.5 else None
 
     def stiffness_for_tangent(self, k_target: float, k_lin: float) -> float:
         """The stiffness parameter whose tangent stiffness at the same load would be
@@ -346,6 +355,11 @@ class JohnsonCylinder(NormalLaw):
 
     #: ``K_lin`` goes as ``K`` up to a logarithm
     tangent_scales_exactly: ClassVar[bool] = False
+
+    @property
+    def hertz_stiffness(self):
+        """None: ``stiffness`` is pi L E* of a line contact (N/m), not a Hertz constant."""
+        return None
 
     def static_penetration(self, load):
         """Johnson's approach under ``load`` N (:func:`.contact.johnson_cylinder_approach`), m."""
