@@ -109,10 +109,21 @@ _OTHER_METHODS = {"RK45": "'LSODA' or 'Radau'", "DOP853": "'LSODA' or 'Radau'",
 def _stiffness_advice(sysm, settings: SolverSettings | None = None) -> str:
     """What to change after a failed or over-budget run: the key that limits the step (from
     ``settings.time_scales``; the stiffness when not estimated) and a method other than the
-    one in use."""
-    if not sysm.clearances:
-        return "tighten nothing: ideal joints only; check the speed and masses"
+    one in use. With ideal joints only: the stiffest kept elastic mode of the flexible bodies
+    (Radau, or fewer modes), else the speed and masses."""
     method = settings.method if settings is not None else "RK45"
+    if not sysm.clearances:
+        from .stepbound import stiffest_mode
+
+        mode = stiffest_mode([b for b in sysm.bodies if getattr(b, "n_elastic", 0) > 0])
+        if mode is None:
+            return "tighten nothing: ideal joints only; check the speed and masses"
+        body, hz = mode
+        change = ("raise solver.max_rhs_evals" if method in ("Radau", "BDF")
+                  else "use solver.method = 'Radau'")
+        return (f"ideal joints only: the stiffest kept mode ({hz:.4g} Hz of {body!r}) is the "
+                f"stiff part: {change} or keep fewer modes of {body!r} (n_modes / cutoff_hz of "
+                f"its [dynamics.flexible] table)")
     other = _OTHER_METHODS.get(method, "'Radau'")
     if settings is not None and settings.time_scales:
         from .timescales import responsible
