@@ -284,6 +284,8 @@ def test_scene_runs_a_flexible_coupler_and_rocker_against_the_rigid_twin(bars, t
     assert set(d["bodies"]) == {"coupler", "rocker"}
     assert d["bodies"]["coupler"]["interfaces"] == {"B": "end_x0", "C": "end_x1"}
     assert d["bodies"]["rocker"]["extra_inertia_kgm2"] == pytest.approx(0.3728)
+    assert d["bodies"]["rocker"]["extra_inertia_frame"] == "D"  # attached at the shaft
+    assert d["bodies"]["rocker"]["extra_inertia_interface"] == "end_x0"
     assert set(d["rigid"]) == {"main_bearing", "B", "C", "D"}
     assert d["rigid"]["C"]["rigid_peak_n"] > 100.0
     assert "bar_" in d["files"]["rocker"]

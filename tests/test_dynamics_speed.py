@@ -153,7 +153,7 @@ def _synthetic_flexible(name, k, frames, rng, mass=1.5, j0=4e-3, tilt=0):
                         damping_ratio=0.03, c=rng.normal(size=k) * 1e-3, n_tilt=tilt)
 
 
-def _flexible_train(seed=3, clearance=True):
+def _flexible_train(seed=3, clearance=True, attach=False):
     rng = np.random.default_rng(seed)
     cyls = [Cylinder(axis_angle=a, rod_length=0.14, rod_mass=0.9, rod_inertia=3.1e-3,
                      rod_com=0.042, piston_mass=0.75, ring_friction=30.0,
@@ -162,6 +162,10 @@ def _flexible_train(seed=3, clearance=True):
                                 mass=2.0, j0=0.01, tilt=2)
     rods = [_synthetic_flexible(f"rod_{i}", 5, {"big": (-0.042, 0.0), "small": (0.098, 0.0)},
                                 rng, mass=0.9, j0=3.1e-3) for i in (1, 2)]
+    if attach:  # point rotary inertias on interfaces (two on one rod, one on the tilted crank)
+        crank.attach_inertia("pin", 4e-3)
+        rods[0].attach_inertia("small", 2e-3)
+        rods[0].attach_inertia("big", 1e-3)
     kw = {"law": "impact", "law_params": PARAMS, "friction": "coulomb",
           "friction_params": FRICTION}
     cl = {"big_end_1": {"clearance": 1e-4, "journal_radius": 0.02}} if clearance else None
@@ -201,6 +205,29 @@ def test_flexible_bodies_compiled_equal_the_python_path_state_by_state():
         assert sysm.gap(0, q) == pytest.approx(sysm.clearances[0].gap(sysm, q), rel=1e-12)
         in_contact += kp["fn"] > 0.0
     assert in_contact >= 3
+
+
+def test_attached_inertias_compiled_equal_the_python_path_state_by_state():
+    """Rotary inertias attached to interfaces (crank pin with tilts, both ends of one rod): the
+    compiled kernel's M(ξ) terms (Σ J_s, Σ J_s r_z, Σ J_s r_z r_zᵀ packed into fb_f) against
+    FlexibleBody.mass_matrix, via the accelerations and multipliers at random states; the
+    attachments change the accelerations (so the comparison is not of two unchanged paths)."""
+    mech = _flexible_train(attach=True)
+    bare = _flexible_train(attach=False)
+    sysm = mech.system
+    assert sysm.kernel() is not None
+    n = sysm.n
+    for t, q, qd, y, v_impact in _states(mech, 5, 6):
+        vimp = np.array([v_impact])
+        py, co = _both(sysm, sysm.rhs, t, y, vimp)
+        for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
+            np.testing.assert_allclose(co[blk], py[blk], rtol=0,
+                                       atol=1e-10 * np.max(np.abs(py[blk])) + 1e-300)
+        sp, sc = _both(sysm, sysm.solve, t, q, qd, vimp)
+        np.testing.assert_allclose(sc["lam"], sp["lam"], rtol=0,
+                                   atol=1e-10 * np.max(np.abs(sp["lam"])))
+        other = bare.system.rhs(t, y, vimp)[n:2 * n]
+        assert np.max(np.abs(other - co[n:2 * n])) > 1e-3 * np.max(np.abs(co[n:2 * n]))
 
 
 def test_the_kernel_integrates_every_power_the_system_names():

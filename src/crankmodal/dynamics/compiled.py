@@ -261,7 +261,8 @@ def _clearance(j, pose, vel, cl_int, cl_f, out):
 @njit(cache=True)
 def _flexible(q, qd, fb_int, fb_f, Q, A):
     """Each flexible body's quadratic velocity, elastic and modal damping forces into ``Q`` and
-    its mass block ``M(ξ)`` (the θ, ξ rows and columns) into ``A``, as
+    its mass block ``M(ξ)`` (the θ, ξ rows and columns, with the constant terms of its attached
+    rotary inertias ``Σ J_s``, ``Σ J_s r_z``, ``Σ J_s r_z r_zᵀ``) into ``A``, as
     :class:`~.flexible.FlexibleBody` computes them; returns the modal damping power, W."""
     p_modal = 0.0
     for bi in range(fb_int.shape[0]):
@@ -270,6 +271,8 @@ def _flexible(q, qd, fb_int, fb_f, Q, A):
         ob, oc, oG = o + 2, o + 2 + k, o + 2 + 2 * k
         oS, oK = oG + k * k, oG + 2 * k * k
         oC = oK + k
+        oJ = oC + k  # attached inertias: Σ J_s, then Σ J_s r_z (k), Σ J_s r_z r_zᵀ (k × k)
+        oh, oH = oJ + 1, oJ + 1 + k
         t, m0 = c0 + 2, c0 + 3
         w = qd[t]
         cv = np.empty(k)
@@ -283,14 +286,14 @@ def _flexible(q, qd, fb_int, fb_f, Q, A):
             mtt += (fb_f[ob + a] + g) * q[m0 + a]  # J0 + 2bᵀξ + ξᵀGξ
             q_th += g * qd[m0 + a]
         Q[t] += -2.0 * w * q_th
-        A[t, t] = mtt
+        A[t, t] = mtt + fb_f[oJ]
         for a in range(k):
             sx = 0.0
-            h = fb_f[oc + a]
+            h = fb_f[oc + a] + fb_f[oh + a]
             for b in range(k):
                 sx += fb_f[oS + a * k + b] * qd[m0 + b]
                 h += fb_f[oS + b * k + a] * q[m0 + b]  # c + Sᵀξ
-                A[m0 + a, m0 + b] = fb_f[oG + a * k + b]
+                A[m0 + a, m0 + b] = fb_f[oG + a * k + b] + fb_f[oH + a * k + b]
             A[t, m0 + a] = h
             A[m0 + a, t] = h
             xd = qd[m0 + a]
@@ -657,8 +660,9 @@ class CompiledSystem:
             if isinstance(b, FlexibleBody):
                 mdiag[s.start:s.start + 2] = b.mass
                 fb_int.append((s.start, b.n_modes, sum(a.size for a in fb_f)))
+                Js, h, H = b.attached_terms()
                 fb_f.append(np.concatenate([[b.mass, b.j0], b.b, b.c, np.ravel(b.G),
-                                            np.ravel(b.S), b.K, b.C]))
+                                            np.ravel(b.S), b.K, b.C, [Js], h, np.ravel(H)]))
             else:
                 Q0[s] += b.velocity_forces(z, z)
                 mdiag[s] = np.diag(b.mass_matrix(z))

@@ -353,14 +353,15 @@ def rigid_twin(body):
     A crank with tilts (held at two or more journals) stays a :class:`~.flexible.FlexibleBody`
     with its tilts and no elastic mode (:meth:`~.flexible.FlexibleBody.frozen`), so that each
     journal's force is still defined; any other body becomes a :class:`~.bodies.RigidBody`
-    (the fast path).
+    (the fast path). Rotary inertias attached to its interfaces
+    (:meth:`~.flexible.FlexibleBody.attach_inertia`) are kept: frozen, they add to ``J₀``.
     """
     from .bodies import RigidBody
 
     if body.n_tilt:
         return body.frozen()
     frames = {n: (float(s0[0]), float(s0[1])) for n, (s0, _, _) in body.frames.items()}
-    return RigidBody(body.name, body.mass, body.j0, frames, z=body.z)
+    return RigidBody(body.name, body.mass, body.j0 + body.attached_inertia, frames, z=body.z)
 
 
 __all__ = ["crank_body", "crank_interface_specs", "flexbody_cache_dir", "link_body", "read",

@@ -21,9 +21,23 @@ and y are dropped. From the invariants (``[2, …]`` is the z component)::
     S  = I5[2]               S[a, b] = ∫ρ (φ_a × φ_b)_z, antisymmetric (k, k)
     J₀ = inertia[2, 2]       polar moment about the centre of mass, kg m²
 
-    M(ξ) = [[m I₂, 0,                 0    ],
-            [0,    J₀ + 2bᵀξ + ξᵀGξ,  ξᵀS  ],
-            [0,    Sᵀξ,               G    ]]
+    M(ξ) = [[m I₂, 0,                 0          ],
+            [0,    J₀ + 2bᵀξ + ξᵀGξ,  (c + Sᵀξ)ᵀ ],
+            [0,    c + Sᵀξ,           G          ]]
+
+(``c = I4[2]``, zero for mean axes, kept as stored.)
+
+Point rotary inertias attached to interfaces (:meth:`FlexibleBody.attach_inertia`; the loom's
+sley on the rocker's shaft): a rotor of polar moment ``J_s`` (kg m², its mass on the interface
+node, or on a fixed pivot) turns with the interface, whose angle is ``φ = θ + r_zᵀξ``, so its
+kinetic energy is ``T_s = ½ J_s (θ̇ + r_zᵀξ̇)² = ½ q̇ᵀ H q̇`` with the constant matrix ::
+
+    H[θ, θ] = J_s,   H[θ, ξ] = H[ξ, θ]ᵀ = J_s r_zᵀ,   H[ξ, ξ] = J_s r_z r_zᵀ
+
+added to ``M(ξ)``. ``r_z`` is constant and ``T_s`` does not depend on ``q``, so ``∂T_s/∂q = 0``
+and ``Ṁ_s = 0``: the rotor adds no centrifugal or Coriolis force (its mass at the interface node
+would: the node's velocity depends on ``θ`` and ``ξ``; it is left out, as it is at a pin on the
+ground). Frozen (0 modes), ``H`` is ``J_s`` on ``θ``: a rigid body's inertia plus ``J_s``.
 
 Only modes whose in-plane mass share ``G_aa`` is at least ``min_in_plane`` are offered (an
 out-of-plane bending or a torsion mode would keep its 3D stiffness with almost no planar mass);
@@ -112,6 +126,43 @@ class FlexibleBody:
         self.z = float(z)
         self.info = dict(info or {})
         self.source = source  # the reduced body it was made from (stress modes, mesh), or None
+        #: point rotary inertias attached to interfaces: ((frame, J_s in kg m²), …), a tuple so
+        #: that a copy (:meth:`frozen`, a mechanism's twin) never shares later attachments
+        self.attached = ()
+
+    def attach_inertia(self, frame: str, inertia: float) -> None:
+        """Attach a point rotary inertia ``inertia`` (kg m², ≥ 0) to interface ``frame``: it turns
+        with the interface (angle ``θ + r_zᵀξ``), adding ``½ J_s (θ̇ + r_zᵀξ̇)²`` to the kinetic
+        energy (the module docstring). Several attachments add up.
+
+        Raises
+        ------
+        ValueError
+            No such frame, or ``inertia`` negative or not finite.
+        """
+        if frame not in self.frames:
+            raise ValueError(f"{self.name}: no frame {frame!r} to attach an inertia to; frames: "
+                             f"{', '.join(self.frames) or 'none'}")
+        J = float(inertia)
+        if not (np.isfinite(J) and J >= 0.0):
+            raise ValueError(f"{self.name}: attached inertia = {inertia!r}: must be >= 0 kg m^2")
+        self.attached = self.attached + ((frame, J),)
+
+    @property
+    def attached_inertia(self) -> float:
+        """Sum of the attached rotary inertias, kg m² (what a frozen twin adds to ``J₀``)."""
+        return float(sum(J for _, J in self.attached))
+
+    def attached_terms(self) -> tuple[float, np.ndarray, np.ndarray]:
+        """The attached inertias' constant mass terms: ``Σ J_s`` (θ, θ), ``Σ J_s r_z`` (θ, ξ;
+        shape (k,)) and ``Σ J_s r_z r_zᵀ`` (ξ, ξ; shape (k, k)), kg m², kg m² per ξ, …"""
+        k = self.n_modes
+        h, H = np.zeros(k), np.zeros((k, k))
+        for frame, J in self.attached:
+            rz = self.frames[frame][2]
+            h += J * rz
+            H += J * np.outer(rz, rz)
+        return self.attached_inertia, h, H
 
     def alias(self, name: str, frame: str) -> None:
         """Name interface ``frame`` also ``name`` (a mechanism's frame names: ``main``, ``pin``…)."""
@@ -150,10 +201,17 @@ class FlexibleBody:
         M[2, 3:] = h
         M[3:, 2] = h
         M[3:, 3:] = self.G
+        if self.attached:
+            Js, h, H = self.attached_terms()
+            M[2, 2] += Js
+            M[2, 3:] += h
+            M[3:, 2] += h
+            M[3:, 3:] += H
         return M
 
     def velocity_forces(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        """Quadratic velocity forces ``∂T/∂q − Ṁ q̇`` (centrifugal and Coriolis), N, N m."""
+        """Quadratic velocity forces ``∂T/∂q − Ṁ q̇`` (centrifugal and Coriolis), N, N m
+        (attached rotary inertias add none: their mass terms are constant)."""
         xi, w, xid = q[3:], qd[2], qd[3:]
         c = self.b + self.G @ xi
         out = np.zeros(self.ndof)
@@ -186,7 +244,7 @@ class FlexibleBody:
         return 0.5 * float(self.K @ (q[3:] ** 2))
 
     def kinetic_energy(self, q: np.ndarray, qd: np.ndarray) -> float:
-        """J."""
+        """``½ q̇ᵀ M(ξ) q̇`` (attached inertias included), J."""
         return 0.5 * float(qd @ self.mass_matrix(q) @ qd)
 
     # ----------------------------------------------------------------- interface frames

@@ -241,6 +241,9 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
             d["interfaces"] = b.info["roles"]
         if "extra_inertia_kgm2" in b.info:  # the four-bar's sley on a flexible rocker
             d["extra_inertia_kgm2"] = b.info["extra_inertia_kgm2"]
+            for key in ("extra_inertia_frame", "extra_inertia_interface"):  # where it sits
+                if key in b.info:
+                    d[key] = b.info[key]
         stress = dynamic_stress(b, modal[sel], t, hist.crank_angle[sel])
         if stress is not None:
             d["dynamic_stress"] = stress

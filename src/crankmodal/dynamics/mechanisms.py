@@ -314,9 +314,12 @@ def _link_length(body, role: str, length: float) -> float:
     return d
 
 
-def _with_extra_inertia(body, extra: float):
-    """A copy of ``body`` with ``extra`` (kg m²) added to its polar moment about its centre of
-    mass (a rigid body's ``inertia``, a flexible body's ``j0``)."""
+def _with_extra_inertia(body, extra: float, frame: str = "D"):
+    """A copy of ``body`` carrying ``extra`` (kg m²) at its ``frame``: a rigid body's
+    ``inertia`` plus ``extra``; a flexible body's rotary inertia attached to that interface
+    (:meth:`~.flexible.FlexibleBody.attach_inertia`: it turns with the interface, ``θ + r_zᵀξ``,
+    not with the mean axes), recorded in its ``info`` (``extra_inertia_kgm2``,
+    ``extra_inertia_frame``, ``extra_inertia_interface``)."""
     import copy
 
     if extra == 0.0:
@@ -327,8 +330,11 @@ def _with_extra_inertia(body, extra: float):
         return twin
     for cache in ("_stacked", "_geo", "_bias"):
         twin.__dict__.pop(cache, None)
-    twin.j0 = body.j0 + extra
-    twin.info = dict(body.info, extra_inertia_kgm2=extra)
+    twin.attach_inertia(frame, extra)
+    twin.info = dict(body.info, extra_inertia_kgm2=extra, extra_inertia_frame=frame)
+    interface = body.info.get("roles", {}).get(frame)
+    if interface is not None:
+        twin.info["extra_inertia_interface"] = interface
     return twin
 
 
@@ -371,8 +377,10 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
     extra_rocker_inertia : float
         Inertia rigidly attached to the rocker about D (e.g. sley and sword), kg m^2. It is
         added to the rocker's moment about its centre of mass (its mass taken as centred on the
-        fixed pivot D, so only its inertia acts); on a flexible rocker it is added to ``J₀``,
-        i.e. it turns with the rocker's mean axes, not with the D interface alone.
+        fixed pivot D, so only its inertia acts); on a flexible rocker it is a rotary inertia
+        attached to the ``D`` interface (kinetic energy ``½ J_s (θ̇ + r_zᵀξ̇)²``: it turns with
+        the shaft, so its inertia torque enters the rocker there), recorded in the rocker's
+        ``info`` (``extra_inertia_kgm2``, ``extra_inertia_frame``).
     branch : {1, -1}
         Assembly mode (which side of BD the joint C lies on).
     direction : {1, -1}
