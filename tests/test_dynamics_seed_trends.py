@@ -22,12 +22,19 @@ from crankmodal.scene import load_scene
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 
 
-def _run(scene, overrides, dt=None, ideal=False):
+def _run(scene, overrides, dt=None, ideal=False, trajectory=0):
     """History of a scene with overrides, output every ``dt`` s (default 0.5 deg of crank);
-    ``ideal``: every clearance joint made ideal."""
+    ``ideal``: every clearance joint made ideal; ``trajectory`` k > 0 starts from the state
+    perturbed as the k-th trajectory of ``dynamics.ensemble`` (relative k x 1e-12)."""
+    from dataclasses import replace
+
+    from crankmodal.dynamics.ensemble import EPS
+
     params = check(load_scene(SCENES / scene, overrides))
     p = params["dynamics"]
     mech = build_mechanism(p, params.get("mechanism"))
+    if trajectory:
+        mech = replace(mech, q0=np.asarray(mech.q0, float) * (1.0 + trajectory * EPS))
     return simulate(mech, p["end_time"], dt or 1.0 / (720 * mech.revolution_hz),
                     solver_settings(p, 60 * mech.revolution_hz), ideal=ideal)
 
@@ -64,12 +71,13 @@ def test_seed003_impact_velocity_in_the_worn_big_end_rises_with_wear():
 # -- seed 000 Sec. 3.2 sweeps, as in notebooks/seed_trends.py (0.1 s ramp, statistics over three
 # revolutions from 0.15 s); numbers of the 5-revolution notebook run in the comments
 
-def _four_star(c, rpm, n_rev=3, friction="coulomb"):
+def _four_star(c, rpm, n_rev=3, friction="coulomb", trajectory=0):
     t0 = 0.15
     h = _run("four_star_dynamics.toml", [
         f"dynamics.end_time={t0 + n_rev * 60.0 / rpm}", "dynamics.ramp_time=0.1",
         f"dynamics.speed_rpm={rpm}", f"dynamics.friction.law='{friction}'",
-        f"dynamics.clearances=[{{joint='big_end_1', clearance={c}, journal_radius=0.0225}}]"])
+        f"dynamics.clearances=[{{joint='big_end_1', clearance={c}, journal_radius=0.0225}}]"],
+        trajectory=trajectory)
     sel = h.t >= t0 - 1e-12
     ons = [o for o in h.onsets["big_end_1"] if o[0] >= t0]
     st = impact_statistics(ons, h.separations["big_end_1"], v_min=1e-3)
@@ -83,14 +91,28 @@ def _four_star(c, rpm, n_rev=3, friction="coulomb"):
 
 @pytest.mark.slow
 def test_seed000_fig26_clearance_broadens_the_main_bearing_spectrum_and_fig24_raises_peaks():
-    # broadband = share of the x-force variance between the engine-order lines 1..40: ideal
-    # joints 2e-6; 0.10 / 0.15 / 0.20 mm: 0.24 / 0.67 / 0.83; piston acceleration peaks
-    # 6.5e3 / 4.2e4 / 6.0e4 m/s^2 (ideal 916)
-    r = [_four_star(c, 1480.0) for c in (1.0e-4, 1.5e-4, 2.0e-4)]
-    bb = [x["broadband"] for x in r]
-    acc = [x["acc_peak"] for x in r]
-    assert 0.1 < bb[0] < bb[1] < bb[2]
-    assert acc[0] > 3.0 * 916.0 and acc[1] > 1.3 * acc[0] and acc[2] > 1.1 * acc[1]
+    # broadband = share of the x-force variance between the engine-order lines 1..40 (ideal
+    # joints 2e-6). The rattling big end is chaotic: over three revolutions one trajectory of
+    # 0.10 mm gave 0.56 and the next, started 1e-12 apart, 0.20; so each clearance runs an
+    # ensemble of 4 trajectories (as dynamics.ensemble) and the trend is asserted on their
+    # means against the trajectory-to-trajectory standard error. Measured (0.10 / 0.15 / 0.20
+    # mm): broadband 0.34 +- 0.10 / 0.49 +- 0.09 / 0.82 +- 0.02, piston acceleration peak
+    # 13 +- 4.5 / 23 +- 7.3 / 58 +- 1.5 km/s^2 (ideal 916 m/s^2).
+    runs = [[_four_star(c, 1480.0, trajectory=k) for k in range(4)]
+            for c in (1.0e-4, 1.5e-4, 2.0e-4)]
+
+    def mean_sem(key):
+        v = np.array([[r[key] for r in rows] for rows in runs])
+        return v.mean(axis=1), v.std(axis=1, ddof=1) / np.sqrt(v.shape[1]), v
+
+    bb, bb_sem, bb_all = mean_sem("broadband")
+    acc, acc_sem, acc_all = mean_sem("acc_peak")
+    assert bb_all.min() > 0.1                       # every trajectory: far off the ideal 2e-6
+    assert acc_all.min() > 3.0 * 916.0              # every trajectory: far above ideal joints
+    for m, e in ((bb, bb_sem), (acc, acc_sem)):
+        assert m[2] - m[0] > 2.0 * np.hypot(e[0], e[2])     # 0.20 mm clearly above 0.10 mm
+        assert m[1] > m[0] - 2.0 * np.hypot(e[0], e[1])     # no significant reversal between
+        assert m[2] > m[1] - 2.0 * np.hypot(e[1], e[2])
 
 
 def _four_star_record(rpm, friction="coulomb", span=0.405, dt=2e-5):

@@ -215,29 +215,45 @@ def test_a_run_without_clearance_keeps_the_peak_headline(tmp_path):
 
 
 @pytest.mark.slow
-def test_four_star_per_revolution_statistics_agree_across_tolerances_within_their_error(tmp_path):
-    # The demo's dynamics (0.3 s: 3 revolutions after the start-up) at rtol 1e-6 and 1e-7: the
-    # single trajectories differ (the raw peak contact force 22.4 / 18.5 kN), the 24
-    # per-revolution statistics agree within 2 standard errors (or 1 %).
+def test_four_star_statistics_move_with_the_tolerance_no_more_than_between_trajectories(tmp_path):
+    # The demo's dynamics (0.3 s: 3 revolutions after the start-up) at rtol 1e-6 and 1e-7, and
+    # an ensemble of 4 trajectories at rtol 1e-6 started 1e-12 apart. The big end rattles
+    # chaotically: one trajectory's per-rev main-bearing peak is ~58 kN, another's ~14 kN, far
+    # beyond each run's standard error over its 3 revolutions (~6 kN). A tolerance change is one
+    # more such perturbation, so (i) each statistic the ensemble spreads moves with the
+    # tolerance by no more than that spread (plus 2 standard errors): the tolerance is not what
+    # limits the result; (ii) the smooth part converges outright (order 1 within 1 %); (iii)
+    # the study flags honestly: a change beyond 2 standard errors (and 1 %) is NOT converged,
+    # and the summary counts what converged. (Before the ensemble existed this test asserted
+    # 24/24 within 2 standard errors: true of one pair of trajectories, not of the system.)
     from crankmodal.runner import run
     from crankmodal.scene import load_scene
 
     scene = load_scene("scenes/four_star_dynamics.toml",
                        ["dynamics.end_time=0.3", "dynamics.run_ideal=false",
-                        "dynamics.solver.rtol=1e-6", "dynamics.solver.study_rtols=[1e-6]"])
+                        "dynamics.solver.rtol=1e-6", "dynamics.solver.study_rtols=[1e-6]",
+                        "dynamics.ensemble=4"])
     res = run(scene, tmp_path, figures=False)["dynamics"]
     study = res["tolerance_study"]
     assert study["rtol"] == pytest.approx([1e-6, 1e-7])
     assert study["d_peak_contact_force"][0] > 0.1             # the raw peak has not converged
     conv = study["statistics"]
     assert len(conv) == 24
+    spread = res["ensemble"]["spread"]
+    for name, key in (("main_bearing_per_rev_peak", "main_bearing_per_rev_peak_n"),
+                      ("main_bearing_rms", "main_bearing_rms_n"),
+                      ("big_end_1_impacts_per_rev", "big_end_1_impacts_per_rev")):
+        c, e = conv[name], spread[key]
+        d = abs(c["value"][0] - c["value"][1])
+        assert d <= (e["max"] - e["min"]) + 2.0 * np.hypot(c["sem"][0], c["sem"][1]), name
+    assert conv["main_bearing_order_1"]["rel_change"][0] < 0.01
+    n_ok = 0
     for name, c in conv.items():
         d = abs(c["value"][0] - c["value"][1])
-        assert d <= 2.0 * np.hypot(c["sem"][0], c["sem"][1]) or d <= 0.01 * abs(c["value"][1]), name
-        assert c["converged"] == [True, True], name
-    # the first order of the main-bearing force is converged outright, not only statistically
-    assert conv["main_bearing_order_1"]["rel_change"][0] < 0.01
-    assert "24/24 per-rev statistics converged at rtol 1e-06" in res["summary"]
+        within = d <= 2.0 * np.hypot(c["sem"][0], c["sem"][1]) or d <= 0.01 * abs(c["value"][1])
+        assert c["converged"][0] == within, name
+        n_ok += within
+    assert f"{n_ok}/24 per-rev statistics converged at rtol 1e-06" in res["summary"]
 
 
 def test_an_ensemble_shows_the_spread_of_an_impacting_run_and_none_of_a_smooth_one(tmp_path):
