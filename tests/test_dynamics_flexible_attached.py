@@ -11,7 +11,7 @@ import copy
 import numpy as np
 import pytest
 import scipy.linalg as sla
-from test_dynamics_flexible_fourbar import BARS, LOOM, SPEC
+from test_dynamics_flexible_fourbar import BARS, LOOM, SPEC, fe_bar
 
 from crankmodal.dynamics import flexbuild
 from crankmodal.dynamics.analysis import simulate
@@ -133,18 +133,8 @@ def _pinned_fe_hz(inertia, both=False):
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from crankmodal.fem.assembly import assemble
-    from crankmodal.fem.materials import Material
-    from crankmodal.fem.testparts import bar
-    from crankmodal.reduction.interfaces import distributing_rows, make_interfaces
 
-    L, w, t, h = BARS["rocker"]
-    div = tuple(max(1, int(np.ceil(d / h))) for d in (L, w, t))
-    part = bar(L, w, t, div, order=2)
-    model = assemble(part, Material("steel", 2.1e11, 0.3, 7850.0))
-    itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
-                                 for n in ("end_x0", "end_x1")])
-    _, G = distributing_rows(model.points, model.cells, itf)
+    model, G = fe_bar("rocker")
     G = sp.csr_matrix(G)
     g, C = G[5], G[0:3]  # end_x0 (D): rotation about z; translations
     if both:

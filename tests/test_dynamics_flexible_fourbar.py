@@ -27,6 +27,24 @@ BARS = {"crank": (0.035, 0.02, 0.02, 0.01), "coupler": (0.075, 0.012, 0.008, 0.0
         "rocker": (0.145, 0.02, 0.012, 0.012)}
 
 
+def fe_bar(role):
+    """The full FE model of a link's test bar (``BARS[role]``: steel, P2, the mesh the
+    reduction uses) and its two end faces' distributing (RBE3) rows ``G`` (12, ndof): the
+    oracle the reduced links are checked against. Returns ``(model, G)``."""
+    from crankmodal.fem.assembly import assemble
+    from crankmodal.fem.materials import Material
+    from crankmodal.fem.testparts import bar
+    from crankmodal.reduction.interfaces import distributing_rows, make_interfaces
+
+    L, w, t, h = BARS[role]
+    div = tuple(max(1, int(np.ceil(d / h))) for d in (L, w, t))
+    part = bar(L, w, t, div, order=2)
+    model = assemble(part, Material("steel", 2.1e11, 0.3, 7850.0))
+    itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
+                                 for n in ("end_x0", "end_x1")])
+    return model, distributing_rows(model.points, model.cells, itf)[1]
+
+
 @pytest.fixture(scope="module")
 def bars():
     """The three links as coarse P2 bars reduced on their end faces (cached after a first run)."""
@@ -87,18 +105,8 @@ def _coupler_static_fe(load_c, g_body):
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from crankmodal.fem.assembly import assemble
-    from crankmodal.fem.materials import Material
-    from crankmodal.fem.testparts import bar
-    from crankmodal.reduction.interfaces import distributing_rows, make_interfaces
 
-    L, w, t, h = BARS["coupler"]
-    div = tuple(max(1, int(np.ceil(d / h))) for d in (L, w, t))
-    part = bar(L, w, t, div, order=2)
-    model = assemble(part, Material("steel", 2.1e11, 0.3, 7850.0))
-    itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
-                                 for n in ("end_x0", "end_x1")])
-    _, G = distributing_rows(model.points, model.cells, itf)
+    model, G = fe_bar("coupler")
     Gb, Gc = G[:6], G[6:]
     n = model.K.shape[0]
     kkt = sp.bmat([[model.K, Gb.T], [Gb, None]], format="csc")
@@ -211,18 +219,8 @@ def _coupler_pinned_pinned_fe_hz():
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from crankmodal.fem.assembly import assemble
-    from crankmodal.fem.materials import Material
-    from crankmodal.fem.testparts import bar
-    from crankmodal.reduction.interfaces import distributing_rows, make_interfaces
 
-    L, w, t, h = BARS["coupler"]
-    div = tuple(max(1, int(np.ceil(d / h))) for d in (L, w, t))
-    part = bar(L, w, t, div, order=2)
-    model = assemble(part, Material("steel", 2.1e11, 0.3, 7850.0))
-    itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
-                                 for n in ("end_x0", "end_x1")])
-    _, G = distributing_rows(model.points, model.cells, itf)
+    model, G = fe_bar("coupler")
     C = sp.vstack([G[0:3], G[6:9]]).tocsr()
     alpha = 1e6 * model.K.diagonal().max() / abs(C).max() ** 2
     lam, u = spla.eigsh((model.K + alpha * (C.T @ C)).tocsc(), 6, model.M.tocsc(), sigma=0.0)

@@ -175,6 +175,20 @@ def _flexible_train(seed=3, clearance=True, attach=False):
                        rod_bodies=rods, clearances=cl, contact_kw=kw, gravity=(0.0, -9.81))
 
 
+def _flexible_paths_agree(sysm, t, q, qd, y, vimp):
+    """Both paths' right-hand sides (every block) and multipliers agree to 1e-10 of their
+    largest entry at one state; returns ``(py_rhs, compiled_rhs, py_solve, compiled_solve)``."""
+    n = sysm.n
+    py, co = _both(sysm, sysm.rhs, t, y, vimp)
+    for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
+        np.testing.assert_allclose(co[blk], py[blk], rtol=0,
+                                   atol=1e-10 * np.max(np.abs(py[blk])) + 1e-300)
+    sp, sc = _both(sysm, sysm.solve, t, q, qd, vimp)
+    np.testing.assert_allclose(sc["lam"], sp["lam"], rtol=0,
+                               atol=1e-10 * np.max(np.abs(sp["lam"])))
+    return py, co, sp, sc
+
+
 def test_flexible_bodies_compiled_equal_the_python_path_state_by_state():
     """A flexible crank (5 modes + 2 tilts) and two flexible rods (5 modes), a clearance at the
     first big end (a flexible interface), gas and ring friction: the compiled kernel (full KKT
@@ -187,14 +201,8 @@ def test_flexible_bodies_compiled_equal_the_python_path_state_by_state():
     in_contact = 0
     for t, q, qd, y, v_impact in _states(mech, 11, 10):
         vimp = np.array([v_impact])  # passed as the integrator passes it
-        py, co = _both(sysm, sysm.rhs, t, y, vimp)
+        py, _, sp, sc = _flexible_paths_agree(sysm, t, q, qd, y, vimp)
         assert py[2 * n + 5] > 0.0  # modal damping power counted
-        for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
-            np.testing.assert_allclose(co[blk], py[blk], rtol=0,
-                                       atol=1e-10 * np.max(np.abs(py[blk])) + 1e-300)
-        sp, sc = _both(sysm, sysm.solve, t, q, qd, vimp)
-        np.testing.assert_allclose(sc["lam"], sp["lam"], rtol=0,
-                                   atol=1e-10 * np.max(np.abs(sp["lam"])))
         np.testing.assert_allclose(sc["Cq"], sp["Cq"], rtol=0, atol=1e-15)
         np.testing.assert_allclose(sc["phi"], sp["phi"], rtol=0, atol=1e-16)
         kp, kc = sp["contacts"][0], sc["contacts"][0]
@@ -219,13 +227,7 @@ def test_attached_inertias_compiled_equal_the_python_path_state_by_state():
     n = sysm.n
     for t, q, qd, y, v_impact in _states(mech, 5, 6):
         vimp = np.array([v_impact])
-        py, co = _both(sysm, sysm.rhs, t, y, vimp)
-        for blk in (slice(0, n), slice(n, 2 * n), slice(2 * n, None)):
-            np.testing.assert_allclose(co[blk], py[blk], rtol=0,
-                                       atol=1e-10 * np.max(np.abs(py[blk])) + 1e-300)
-        sp, sc = _both(sysm, sysm.solve, t, q, qd, vimp)
-        np.testing.assert_allclose(sc["lam"], sp["lam"], rtol=0,
-                                   atol=1e-10 * np.max(np.abs(sp["lam"])))
+        _, co, _, _ = _flexible_paths_agree(sysm, t, q, qd, y, vimp)
         other = bare.system.rhs(t, y, vimp)[n:2 * n]
         assert np.max(np.abs(other - co[n:2 * n])) > 1e-3 * np.max(np.abs(co[n:2 * n]))
 
