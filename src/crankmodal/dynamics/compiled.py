@@ -211,7 +211,7 @@ def _frames(q, qd, fr, pose, arm, bias, vel):
         vel[k, 2] = w + wz
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _jrow(out, r, k, s, cx, cy, ct, fr, arm):
     """Add ``s (cx, cy, ct) · J_k`` (frame ``k``'s Jacobian rows combined) to row ``r`` of
     ``out``; with ``out`` a column (``r`` = 0 of a (1, n) view) it adds ``J_kᵀ f``."""
@@ -230,7 +230,27 @@ def _jrow(out, r, k, s, cx, cy, ct, fr, arm):
                                    + ct * fmodal[o + 2 * nk + a])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def _pin_rows(Cq, r, k, s, fr, arm):
+    """Add ``s`` times frame ``k``'s position rows (x, y) of its Jacobian to rows ``r`` and
+    ``r + 1`` of ``Cq`` (a pin's two equations; :func:`_jrow` twice, in one pass)."""
+    fcol, _floc, fmn, _fmoff, fadoff, _fmodal, AD = fr
+    i = fcol[k]
+    if i < 0:
+        return
+    Cq[r, i] += s
+    Cq[r + 1, i + 1] += s
+    Cq[r, i + 2] -= s * arm[k, 1]
+    Cq[r + 1, i + 2] += s * arm[k, 0]
+    nk = fmn[k]
+    if nk > 0:
+        a0, m0 = fadoff[k], i + 3
+        for a in range(nk):
+            Cq[r, m0 + a] += s * AD[a0 + a]
+            Cq[r + 1, m0 + a] += s * AD[a0 + nk + a]
+
+
+@njit(cache=True, inline="always")
 def _add_force(Q2, fr, arm, k, fx, fy, mz):
     """``Q += J_kᵀ (fx, fy, mz)``: a force and moment at frame ``k`` (``Q2``: Q as (1, n))."""
     _jrow(Q2, 0, k, 1.0, fx, fy, mz, fr, arm)
@@ -318,13 +338,11 @@ def _seg(a, o, i):
     return a[o[i]:o[i + 1]]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _frame_tables(I, io, F, fo):
     fcol, fmn, fmoff, fadoff = _seg(I, io, 0), _seg(I, io, 1), _seg(I, io, 2), _seg(I, io, 3)
     floc, fmodal = _seg(F, fo, 0).reshape((-1, 3)), _seg(F, fo, 1)
-    n_ad = 0
-    for k in range(fcol.size):
-        n_ad += 2 * fmn[k]
+    n_ad = fadoff[-1] + 2 * fmn[-1] if fcol.size else 0  # fadoff is the running sum
     return fcol, floc, fmn, fmoff, fadoff, fmodal, np.empty(n_ad)
 
 
@@ -426,9 +444,8 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
         phi[r + 1] = pose[a, 1] - pose[b, 1]
         gamma[r] = -(bias[a, 0] - bias[b, 0])
         gamma[r + 1] = -(bias[a, 1] - bias[b, 1])
-        for k, s in ((a, 1.0), (b, -1.0)):
-            _jrow(Cq, r, k, s, 1.0, 0.0, 0.0, fr, arm)
-            _jrow(Cq, r + 1, k, s, 0.0, 1.0, 0.0, fr, arm)
+        _pin_rows(Cq, r, a, 1.0, fr, arm)
+        _pin_rows(Cq, r, b, -1.0, fr, arm)
     for p_i in range(pri_rows.size):
         r, k = pri_rows[p_i], pri_k[p_i]
         n0, n1 = pri_n[p_i, 0], pri_n[p_i, 1]
