@@ -49,6 +49,25 @@ def test_bad_dynamics_value_names_its_key(path, value, needle):
     assert "\n" not in str(exc.value)
 
 
+def test_kelvin_voigt_without_a_stiffness_is_refused_naming_the_key():
+    # its K is linear (N/m): the default from E, nu and the radii is a Hertz constant (N/m^1.5)
+    import copy
+
+    data = copy.deepcopy(SMALL)
+    data["dynamics"]["contact"] = {"law": "kelvin_voigt"}
+    with pytest.raises(SceneError, match=r"^dynamics.contact.stiffness: is required with "
+                                         r"contact.law = 'kelvin_voigt'.* N/m at 10 kN$") as exc:
+        check(_scene(data))
+    # the advice's value: the Hertz tangent 1.5 K^(2/3) F^(1/3) (closed form d(K d^1.5)/dd)
+    from crankmodal.dynamics.contact import cylinder_stiffness
+
+    kh = cylinder_stiffness(0.02, 0.0201, 2.1e11, 0.3, 2.1e11, 0.3)
+    delta = (1e4 / kh) ** (2.0 / 3.0)
+    assert f"{1.5 * kh * delta ** 0.5:.3g} N/m at 10 kN" in str(exc.value)
+    data["dynamics"]["contact"]["stiffness"] = 2e8
+    assert check(_scene(data))["dynamics"]["contact"]["stiffness"] == 2e8
+
+
 def test_from_mechanism_without_a_mechanism_section_is_refused():
     data = {"dynamics": {"mechanism": "four_star", "from_mechanism": True}}
     with pytest.raises(SceneError, match="needs a \\[mechanism\\] section"):

@@ -120,7 +120,8 @@ CONTACT = {
     "law": Field("str", "impact", "normal force law (johnson_cylinder: conformal cylinders, "
                  "needs each clearance's bearing_length)", choices=contact.NORMAL_LAWS),
     "stiffness": Field("float", None, "N/m^exponent (default: from E, nu and the radii); "
-                       "johnson_cylinder: pi L E* in N/m (default: from E, nu and bearing_length)",
+                       "johnson_cylinder: pi L E* in N/m (default: from E, nu and bearing_length); "
+                       "kelvin_voigt: N/m, required",
                        gt=0.0),
     "exponent": Field("float", 1.5, "force exponent", gt=0.0, le=3.0),
     "damping": Field("float", 300.0, "N s/m (impact: full damping; kelvin_voigt, power_damped)", ge=0.0),
@@ -343,6 +344,21 @@ def _cross_checks(p):
         if c["joint"] in seen:
             raise SceneError(f"dynamics.clearances[{i}].joint: {c['joint']!r} given twice")
         seen.add(c["joint"])
+    cont = p["contact"]
+    if cont["law"] == "kelvin_voigt" and cont["stiffness"] is None and p["clearances"]:
+        # the default from E, nu and the radii is the Hertz constant (N/m^1.5) of the power
+        # laws: as a linear K (N/m) it would be a unit error
+        from .contact import cylinder_stiffness
+
+        c0 = p["clearances"][0]
+        r = c0["journal_radius"]
+        kh = cylinder_stiffness(r, r + c0["clearance"], cont["E"], cont["nu"], cont["E"], cont["nu"])
+        k10 = 1.5 * kh ** (2.0 / 3.0) * 1e4 ** (1.0 / 3.0)
+        raise SceneError(
+            "dynamics.contact.stiffness: is required with contact.law = 'kelvin_voigt' (a linear "
+            "K in N/m; the default from E, nu and the radii is the Hertz constant in N/m^1.5 of "
+            f"the other laws); e.g. the tangent of that Hertz contact ({kh:.3g} N/m^1.5 at "
+            f"{c0['joint']!r}) at a load F, 1.5 K^(2/3) F^(1/3): {k10:.3g} N/m at 10 kN")
     g, f = p["gas_force_deg"], p["gas_force_n"]
     if (g is None) != (f is None):
         raise SceneError("dynamics.gas_force_n: give both gas_force_deg and gas_force_n, or none")
