@@ -191,6 +191,21 @@ def test_quasi_static_start_with_the_seed_clearance_at_c_starts_centred(tmp_path
     assert sb["body"] == "coupler" and sb["frequency_hz"] > 1e4 and not sb["bound"]
 
 
+def test_a_truncated_rocker_carrying_the_sley_is_warned_and_a_complete_one_not(bars):
+    from crankmodal.dynamics.flexstage import truncation_warnings
+
+    p = {"mechanism": "four_bar", "four_bar": {"extra_rocker_inertia": 0.3728}}
+    stored = len(_link(bars, "rocker").left_out()["offered_hz"])
+    assert stored >= 3
+    cut = {"links": {"rocker": _link(bars, "rocker", n_modes=2)}}
+    full = {"links": {"rocker": _link(bars, "rocker")}}
+    assert len(truncation_warnings(p, cut)) == 1
+    assert f"keeps 2 of the {stored} stored" in truncation_warnings(p, cut)[0]
+    assert truncation_warnings(p, full) == []
+    assert truncation_warnings(dict(p, four_bar={"extra_rocker_inertia": 0.0}), cut) == []
+    assert truncation_warnings(p, {"links": {"coupler": _link(bars, "coupler", n_modes=1)}}) == []
+
+
 def test_link_bodies_at_the_wrong_length_or_without_their_frames_are_refused(bars):
     # the builder (Python API) names its argument; a scene names the key (the stage's
     # body_keys, and the bad-input cases below through `crankmodal run`)
@@ -277,6 +292,9 @@ def test_scene_runs_a_flexible_coupler_and_rocker_against_the_rigid_twin(bars, t
                                          "fixed_interface_modes": 8, "n_modes": 2}})
     status, err = run_in_process("run", scene, "--out", out, "--no-figures")
     assert status == 0, err
+    # the rocker carries the loom's sley with 2 of its stored modes: warned, by key
+    warned = json.loads((out / "results.json").read_text())["dynamics"]["warnings"]
+    assert any(w.startswith("dynamics.flexible.rocker.n_modes: keeps 2 of the ") for w in warned)
     res = json.loads((out / "results.json").read_text())
     d = next(v for v in _walk(res) if isinstance(v, dict) and "bodies" in v and "rigid" in v)
     assert set(d["bodies"]) == {"coupler", "rocker"}

@@ -428,6 +428,7 @@ def planar_body(fb, name: str, n_modes: int | None = None,
             (np.sum(imap[:, 3:5] ** 2, axis=(0, 1)) / np.maximum(rot, tiny)).tolist(),
         "not_offered": [{"hz": float(f_el[i]), "in_plane_share": float(share[i])}
                         for i in range(len(f_el)) if share[i] < min_in_plane],
+        "offered_hz": f_el[offered].tolist(),
         "translation_coupling_I3": float(np.abs(np.asarray(inv["I3"])).max(initial=0.0)),
         "rotation_coupling_I4z": float(np.abs(np.asarray(inv["I4"])[2]).max(initial=0.0)),
     }

@@ -169,6 +169,11 @@ def run(params: dict, ctx) -> dict:
     scales = timescales.joint_time_scales(mech)
     settings = replace(settings, time_scales=tuple(scales))
     early_warnings = []
+    if bodies is not None:
+        from .flexstage import truncation_warnings
+
+        for text in truncation_warnings(p, bodies):
+            warn(text, into=early_warnings)
     for text in timescales.check_budget(scales, t_end, settings.method, settings.max_rhs_evals):
         warn(text, into=early_warnings)
     start_info = None
