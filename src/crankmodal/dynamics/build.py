@@ -147,7 +147,8 @@ def solver_settings(p, speed_rpm, flexible: bool = False) -> SolverSettings:
         if fr["law"] != "none" and p["clearances"] and slow:
             method = "LSODA"
         # an oil film is stiff near the wall ((1 - eps^2)^-5/2): measured 0.8 s LSODA, minutes RK45
-        if any(c["viscosity"] is not None for c in p["clearances"]):
+        lubricated = any(c["viscosity"] is not None for c in p["clearances"])
+        if lubricated:
             method = "LSODA"
         # flexible bodies on ideal joints: their stiffest modes (kHz) bound an explicit step by
         # stability, which A-stable Radau IIA steps over. Measured (benchmarks/README.md):
@@ -160,7 +161,6 @@ def solver_settings(p, speed_rpm, flexible: bool = False) -> SolverSettings:
         # joint, LSODA stalled at 0.17 of 0.4 s after 2 M evaluations, Radau ran it in 95 k;
         # the four-star with a lubricated big end and flexible rods, Radau 2.5 k evaluations in
         # 2.2 s against LSODA's 9.1 k in 6.6 s)
-        lubricated = any(c["viscosity"] is not None for c in p["clearances"])
         if flexible and (not p["clearances"] or lubricated):
             method = "Radau"
     return SolverSettings(method=method, rtol=s["rtol"], atol=atol,

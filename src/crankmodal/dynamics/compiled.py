@@ -28,6 +28,7 @@ from scipy.linalg.lapack import dgesv as _gesv
 
 from .bodies import Ground, RigidBody
 from .clearance import ClearanceJoint
+from .fastpath import frames_of
 from .flexible import FlexibleBody
 from .joints import AngleDrive, Prismatic, Revolute
 from .loads import CrankTorque, PistonLoads
@@ -568,12 +569,6 @@ def clearance_kinematics(j, q, qd, I, io, F, fo, out):
     _clearance(j, pose, vel, cl_int, cl_f, out)
 
 
-def _frames_of(c):
-    if isinstance(c, Revolute):
-        return [(c.a, c.frame_a), (c.b, c.frame_b)]
-    return [(c.a, c.frame_a)]
-
-
 class CompiledSystem:
     """The tables of one :class:`~.system.Multibody` for :func:`assemble` and :func:`finish`."""
 
@@ -614,7 +609,7 @@ class CompiledSystem:
         row_frames = [[] for _ in range(m)]
         for c, r in zip(sysm.constraints, sysm.rows):
             r0 = r.start
-            ks = [key(b, f) for b, f in _frames_of(c)]
+            ks = [key(b, f) for b, f in frames_of(c)]
             for rr in range(r.start, r.stop):
                 row_frames[rr] += ks
             if isinstance(c, Revolute):

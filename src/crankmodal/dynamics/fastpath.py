@@ -29,7 +29,7 @@ class RigidConstraintTable:
         # frame table: the rigid frames of the cache, then ground frames (fixed, no Jacobian)
         ground = {}
         for c in sysm.constraints:
-            for body, frame in _frames_of(c):
+            for body, frame in frames_of(c):
                 if isinstance(body, Ground) and (id(body), frame) not in ground:
                     ground[(id(body), frame)] = body.frame_pose(None, frame)
         k_rigid = len(sysm._fi)
@@ -124,7 +124,8 @@ class RigidConstraintTable:
         return phi, Cq, nu, gamma
 
 
-def _frames_of(c):
+def frames_of(c):
+    """The (body, frame) pairs a pin, slider or drive constrains."""
     if isinstance(c, Revolute):
         return [(c.a, c.frame_a), (c.b, c.frame_b)]
     return [(c.a, c.frame_a)]
