@@ -43,6 +43,20 @@ def _states(mech, seed, count):
         yield t, q, qd, np.concatenate([q, qd, np.zeros(6)]), rng.uniform(0.01, 2.0)
 
 
+# Two floating-point paths are never compared bit for bit: another x86-64 CPU compiles the kernel
+# with other fused multiply-adds and vector widths, which moves the last bits (seen: 1.4e-15 m/s of
+# 0.104 m/s in a penetration rate). Each quantity is a sum of at most a few hundred products, so the
+# two paths differ by a few hundred ulps of the *terms'* size at most: RTOL = 1e-12 of a scale of the
+# terms (the largest entry of the block, or the state's size) holds on any CPU with two orders to
+# spare, and a wrong term (a sign, a missing factor) shows as O(1e-3) or more.
+RTOL = 1e-12
+
+
+def _close(actual, expected, scale, what=""):
+    """``|actual - expected| <= RTOL * scale`` elementwise; ``scale`` is the size of the terms."""
+    np.testing.assert_allclose(actual, expected, rtol=0, atol=RTOL * scale + 1e-300, err_msg=what)
+
+
 def _both(sysm, fn, *args):
     sysm.compiled = False
     a = fn(*args)
@@ -70,19 +84,26 @@ def test_compiled_rhs_and_solve_equal_the_python_path_state_by_state(law, fricti
         sp, sc = _both(sysm, sysm.solve, t, q, qd)
         np.testing.assert_allclose(sc["lam"], sp["lam"], rtol=0,
                                    atol=1e-11 * np.max(np.abs(sp["lam"])))
-        np.testing.assert_array_equal(sc["phi"], sp["phi"])
-        np.testing.assert_array_equal(sc["Cq"], sp["Cq"])
-        np.testing.assert_array_equal(sc["nu"], sp["nu"])
-        assert sc["p_loads"] == pytest.approx(sp["p_loads"], rel=1e-13, abs=1e-9)
+        q_scale, v_scale = np.max(np.abs(q)), np.max(np.abs(qd))  # m (and rad), m/s (rad/s)
+        _close(sc["phi"], sp["phi"], q_scale, "phi")
+        _close(sc["Cq"], sp["Cq"], np.max(np.abs(sp["Cq"])), "Cq")
+        _close(sc["nu"], sp["nu"], np.max(np.abs(sp["nu"])), "nu")
+        _close(sc["p_loads"], sp["p_loads"], np.max(np.abs(py[2 * n:])) + abs(sp["p_loads"]),
+               "p_loads")
         kp, kc = sp["contacts"][0], sc["contacts"][0]
-        for key in ("delta", "delta_dot", "v_slip", "fn", "ft", "v_elastic", "p_damp", "p_fric",
-                    "d", "r_b", "omega_sum"):
-            assert kc[key] == pytest.approx(kp[key], rel=1e-12, abs=1e-12), key
-        for key in ("e", "n", "t", "force", "vrel", "Jj", "Jb"):
-            np.testing.assert_allclose(kc[key], kp[key], rtol=1e-12, atol=1e-15)
-        assert sysm.gap(0, q) == cj.gap(sysm, q)
-        assert sysm.penetration_rate(0, q, qd) == pytest.approx(
-            cj.kinematics(sysm, q, qd)["delta_dot"], rel=1e-14, abs=1e-16)
+        # the contact's own scales: a length (the clearance, m), a speed, a force
+        length, force = cj.clearance, max(abs(kp["fn"]), abs(kp["ft"]), 1.0)
+        for key, scale in (("delta", length), ("d", length), ("r_b", length + cj.journal_radius),
+                           ("delta_dot", v_scale), ("v_slip", v_scale), ("v_elastic", v_scale),
+                           ("omega_sum", v_scale), ("fn", force), ("ft", force),
+                           ("p_damp", force * v_scale), ("p_fric", force * v_scale)):
+            _close(kc[key], kp[key], scale, key)
+        for key, scale in (("e", length), ("n", 1.0), ("t", 1.0), ("force", force),
+                           ("vrel", v_scale), ("Jj", 1.0 + q_scale), ("Jb", 1.0 + q_scale)):
+            _close(kc[key], kp[key], scale, key)
+        _close(sysm.gap(0, q), cj.gap(sysm, q), length, "gap")
+        _close(sysm.penetration_rate(0, q, qd), cj.kinematics(sysm, q, qd)["delta_dot"], v_scale,
+               "penetration rate")
         in_contact += kp["delta"] > 0.0 and kp["fn"] > 0.0
     assert in_contact >= 3
 
@@ -97,14 +118,14 @@ def test_a_smooth_run_is_the_same_on_both_paths():
         runs.append(simulate(mech, 0.04, 1e-4, SolverSettings(rtol=1e-8, atol=1e-12),
                              ideal=True))
     py, co = runs
-    assert co.nfev == py.nfev
-    scale = np.max(np.abs(py.main_bearing_force))
-    assert np.max(np.abs(co.main_bearing_force - py.main_bearing_force)) < 1e-9 * scale
-    np.testing.assert_allclose(co.piston_acceleration, py.piston_acceleration, rtol=0,
-                               atol=1e-9 * np.max(np.abs(py.piston_acceleration)))
-    for k in ("work_drive", "work_loads", "kinetic"):
-        np.testing.assert_allclose(co.energy[k], py.energy[k], rtol=0,
-                                   atol=1e-9 * np.max(np.abs(py.energy[k])))
+    # the paths' last bits differ by CPU (see RTOL), and an adaptive step accepted at the margin
+    # on one path may be rejected on the other: the evaluations may differ by a few steps and the
+    # histories by the integration tolerance (rtol 1e-8), never by a model difference (>= 1e-3)
+    assert abs(co.nfev - py.nfev) <= 0.02 * py.nfev
+    for a, b in ((co.main_bearing_force, py.main_bearing_force),
+                 (co.piston_acceleration, py.piston_acceleration),
+                 *((co.energy[k], py.energy[k]) for k in ("work_drive", "work_loads", "kinetic"))):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-6 * np.max(np.abs(b)))
 
 
 def test_a_free_journal_without_constraints_is_compiled_too():
@@ -119,7 +140,7 @@ def test_a_free_journal_without_constraints_is_compiled_too():
     assert sysm.kernel() is not None
     y = np.array([1.2e-4, 3e-5, 0.1, 0.3, -0.2, 50.0, 0, 0, 0, 0, 0, 0])
     py, co = _both(sysm, sysm.rhs, 0.0, y)
-    np.testing.assert_allclose(co, py, rtol=1e-13, atol=1e-9)
+    np.testing.assert_allclose(co, py, rtol=RTOL, atol=RTOL * np.max(np.abs(py)))
     assert py[3] < 0.0  # pushed back from the wall
 
 
@@ -203,14 +224,19 @@ def test_flexible_bodies_compiled_equal_the_python_path_state_by_state():
         vimp = np.array([v_impact])  # passed as the integrator passes it
         py, _, sp, sc = _flexible_paths_agree(sysm, t, q, qd, y, vimp)
         assert py[2 * n + 5] > 0.0  # modal damping power counted
-        np.testing.assert_allclose(sc["Cq"], sp["Cq"], rtol=0, atol=1e-15)
-        np.testing.assert_allclose(sc["phi"], sp["phi"], rtol=0, atol=1e-16)
+        q_scale, v_scale = np.max(np.abs(q)), np.max(np.abs(qd))
+        _close(sc["Cq"], sp["Cq"], np.max(np.abs(sp["Cq"])), "Cq")
+        _close(sc["phi"], sp["phi"], q_scale, "phi")
         kp, kc = sp["contacts"][0], sc["contacts"][0]
-        for key in ("delta", "delta_dot", "v_slip", "fn", "ft", "p_damp", "p_fric"):
-            assert kc[key] == pytest.approx(kp[key], rel=1e-11, abs=1e-12), key
-        for key in ("force", "Jj", "Jb"):
-            np.testing.assert_allclose(kc[key], kp[key], rtol=1e-11, atol=1e-15)
-        assert sysm.gap(0, q) == pytest.approx(sysm.clearances[0].gap(sysm, q), rel=1e-12)
+        cj = sysm.clearances[0]
+        length, force = cj.clearance, max(abs(kp["fn"]), abs(kp["ft"]), 1.0)
+        # the flexible path sums over modes too: 10x the rigid tolerance (still 1e-11)
+        for key, scale in (("delta", length), ("delta_dot", v_scale), ("v_slip", v_scale),
+                           ("fn", force), ("ft", force), ("p_damp", force * v_scale),
+                           ("p_fric", force * v_scale), ("force", force),
+                           ("Jj", 1.0 + q_scale), ("Jb", 1.0 + q_scale)):
+            _close(kc[key], kp[key], 10 * scale, key)
+        _close(sysm.gap(0, q), cj.gap(sysm, q), length, "gap")
         in_contact += kp["fn"] > 0.0
     assert in_contact >= 3
 
