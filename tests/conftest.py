@@ -77,3 +77,69 @@ def part_context(part, material, out_dir):
     ctx.products["geometry"] = part
     ctx.products["material"] = material
     return ctx
+
+
+# --- The validation page's data: oracle checks recorded by the tests that make them -----------
+#: ``CRANKMODAL_ORACLES=docs/validation/oracles.json pytest ...`` writes the rows of the tests that
+#: ran into that file (rows of tests that did not run are kept), from which the docs' Validation
+#: page is generated (docs/_ext/crankmodal_docs.py). Without the variable nothing is written.
+ORACLES_ENV = "CRANKMODAL_ORACLES"
+ORACLE_STAGES = ("geometry", "fem", "reduction", "mechanism", "torsion", "dynamics", "flexible",
+                 "report", "sweep")
+_ORACLE_ROWS: list[dict] = []
+_ORACLE_TESTS: set[str] = set()
+
+
+def _oracle_number(name, x):
+    if x is None:
+        return None
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise TypeError(f"oracle {name} must be a number, got {x!r}") from None
+    if v != v or v in (float("inf"), float("-inf")):
+        raise ValueError(f"oracle {name} must be finite, got {v!r}")
+    return v
+
+
+@pytest.fixture
+def oracle(request):
+    """Record one independent-oracle check for the Validation page; returns ``measured``.
+
+    ``oracle(stage="fem", quantity="...", reference="closed form ...", tolerance="0.5 %",
+    measured=f, expected=f_ref)``: ``stage`` one of :data:`ORACLE_STAGES`; ``reference`` names
+    the independent source (closed form, published table, peer code, second formulation);
+    ``tolerance`` is what the test asserts (text or number); ``expected`` may be None when the
+    test checks a bound. Only records: the test still asserts on its own."""
+    _ORACLE_TESTS.add(request.node.nodeid)
+
+    def record(*, stage, quantity, reference, tolerance, measured, expected=None):
+        if stage not in ORACLE_STAGES:
+            raise ValueError(f"oracle stage {stage!r}: one of {', '.join(ORACLE_STAGES)}")
+        _ORACLE_ROWS.append({
+            "stage": stage, "quantity": str(quantity), "reference": str(reference),
+            "tolerance": str(tolerance), "measured": _oracle_number("measured", measured),
+            "expected": _oracle_number("expected", expected), "test": request.node.nodeid,
+        })
+        return measured
+
+    return record
+
+
+def pytest_sessionfinish(session, exitstatus):
+    import json
+
+    path = os.environ.get(ORACLES_ENV)
+    if not path or not _ORACLE_TESTS:
+        return
+    path = Path(path)
+    old = []
+    if path.exists():
+        old = json.loads(path.read_text(encoding="utf-8")).get("oracles", [])
+    rows = [r for r in old if r["test"] not in _ORACLE_TESTS] + _ORACLE_ROWS
+    rows.sort(key=lambda r: (r["stage"], r["test"], r["quantity"]))
+    text = json.dumps({"oracles": rows}, indent=1, ensure_ascii=False) + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)

@@ -57,10 +57,11 @@ def test_hysteresis_law_rebound_matches_exact_energy_integral(law, e):
     assert onsets[1][1] / v0 == pytest.approx(expected, rel=2e-5)
 
 
-def test_lankarani_nikravesh_gives_its_restitution_for_hard_impacts():
+def test_lankarani_nikravesh_gives_its_restitution_for_hard_impacts(oracle):
     # LN (1990) is derived for e near 1: e = 0.9 requested, 0.9 delivered within 1.5 %.
     onsets, _ = _first_two_impacts("lankarani_nikravesh",
                                    {"stiffness": 1e10, "exponent": 1.5, "restitution": 0.9})
+    oracle(stage="dynamics", quantity="Lankarani-Nikravesh law, coefficient of restitution", reference="the law's design value e = 0.9 (LN 1990)", tolerance="1.5 %", measured=onsets[1][1], expected=0.9)
     assert onsets[1][1] == pytest.approx(0.9, rel=0.015)
 
 
@@ -71,12 +72,13 @@ def test_flores_law_gives_its_restitution_over_a_wide_range():
     assert onsets[1][1] == pytest.approx(0.5, rel=0.12)
 
 
-def test_hertz_impact_is_elastic_and_lasts_the_hertz_contact_time():
+def test_hertz_impact_is_elastic_and_lasts_the_hertz_contact_time(oracle):
     # Oracle: Hertz (n = 3/2) contact time 2.9432 d_max / v0, d_max = (5 m v0^2 / 4 K)^(2/5).
     K, v0 = 1e10, 1.0
     onsets, seps = _first_two_impacts("hertz", {"stiffness": K, "exponent": 1.5}, v0)
     d_max = (2.5 * MASS * v0**2 / (2 * K)) ** 0.4
     assert onsets[1][1] == pytest.approx(v0, rel=1e-6)
+    oracle(stage="dynamics", quantity="Hertz impact contact time, s", reference="closed form 2.9432 d_max / v0", tolerance="1e-4", measured=seps[0] - onsets[0][0], expected=2.9432 * d_max / v0)
     assert seps[0] - onsets[0][0] == pytest.approx(2.9432 * d_max / v0, rel=1e-4)
 
 

@@ -167,7 +167,7 @@ def test_pinned_rocker_with_the_sley_rings_at_the_fe_frequency_with_the_inertia_
     assert abs(_pinned_hz(body)[1] / _pinned_fe_hz(0.0) - 1) < 1e-2
 
 
-def test_rocker_pinned_at_both_ends_swings_the_sley_on_its_bending_stiffness(rocker_file):
+def test_rocker_pinned_at_both_ends_swings_the_sley_on_its_bending_stiffness(oracle, rocker_file):
     """The loom at rest holds C (crank held, rigid coupler): the sley at D turns against the
     rocker's bending, a rotary spring 3EI/L (pinned far end), so it swings at
     √(3EI / (L J_s)) / 2π = 48.60 Hz (order 6.5 of 450 rpm). The reduced rocker with the sley
@@ -181,6 +181,7 @@ def test_rocker_pinned_at_both_ends_swings_the_sley_on_its_bending_stiffness(roc
     f = _pinned_hz(att, ("D", "C"))[0]
     closed = np.sqrt(3 * 2.1e11 * t * w ** 3 / 12 / (L * SLEY)) / (2 * np.pi)
     assert f == pytest.approx(_pinned_fe_hz(SLEY, both=True), rel=1e-2)
+    oracle(stage="flexible", quantity="loom rocker with the sley attached at D, swing frequency, Hz", reference="closed form sqrt(3EI / (L J_s)) / 2 pi", tolerance="2 %", measured=f, expected=closed)
     assert f == pytest.approx(closed, rel=2e-2)
     spread = copy.copy(body)
     spread.j0 = body.j0 + SLEY

@@ -36,7 +36,7 @@ def test_short_bearing_force_equals_integrated_reynolds_pressure(eps, eps_dot, g
     assert ft == pytest.approx(ft_ref, abs=1e-6 * scale)
 
 
-def test_static_short_bearing_load_direction_is_the_ocvirk_attitude_angle():
+def test_static_short_bearing_load_direction_is_the_ocvirk_attitude_angle(oracle):
     # Oracle: tan(phi) = pi sqrt(1 - eps^2) / (4 eps) (Ocvirk). For comparison, seed 001 Table 3
     # (L/D = 1, finite bearing) prints 75.11, 63.59, 55.55, 50.08, 45.32, 40.54, 36.02 deg for
     # eps = 0.1 .. 0.7; the short-bearing values are 82.7, 75.4, 68.2, 60.9, 53.7, 46.3, 38.7:
@@ -44,6 +44,7 @@ def test_static_short_bearing_load_direction_is_the_ocvirk_attitude_angle():
     eps = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])
     fr, ft = short_bearing_force(eps, 0.0, 0.0, 100.0, MU, R, L, C)
     expected = np.degrees(np.arctan(np.pi * np.sqrt(1 - eps**2) / (4 * eps)))
+    oracle(stage="dynamics", quantity="short bearing attitude angle at eps = 0.5, deg", reference="Ocvirk closed form tan(phi) = pi sqrt(1 - eps^2) / (4 eps)", tolerance="1e-9 deg", measured=np.degrees(np.arctan2(ft, -fr))[4], expected=expected[4])
     np.testing.assert_allclose(np.degrees(np.arctan2(ft, -fr)), expected, atol=1e-9)
     np.testing.assert_allclose(attitude_angle(eps), expected, atol=1e-12)
 

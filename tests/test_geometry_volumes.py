@@ -85,8 +85,9 @@ def cad_volume(builder, params, fidelity):
 
 
 @pytest.mark.parametrize("fidelity", ["dechamfered", "simplified"])
-def test_crank_volume_equals_closed_form_of_primitives_within_1e_6(fidelity):
+def test_crank_volume_equals_closed_form_of_primitives_within_1e_6(oracle, fidelity):
     v = cad_volume(build_crankshaft, CRANK, fidelity)
+    oracle(stage="geometry", quantity=f"crankshaft volume ({fidelity}), m^3", reference="closed form of the primitives", tolerance="1e-6", measured=v, expected=crank_volume_closed_form(CRANK, fidelity == "simplified"))
     assert v == pytest.approx(crank_volume_closed_form(CRANK, fidelity == "simplified"), rel=1e-6)
 
 
@@ -102,8 +103,9 @@ def test_round_web_crank_volume_equals_closed_form(shape):
 
 
 @pytest.mark.parametrize("fidelity", ["dechamfered", "simplified"])
-def test_rod_volume_equals_closed_form_of_primitives_within_1e_6(fidelity):
+def test_rod_volume_equals_closed_form_of_primitives_within_1e_6(oracle, fidelity):
     v = cad_volume(build_conrod, ROD, fidelity)
+    oracle(stage="geometry", quantity=f"connecting-rod volume ({fidelity}), m^3", reference="closed form of the primitives", tolerance="1e-6", measured=v, expected=rod_volume_closed_form(ROD, fidelity == "simplified"))
     assert v == pytest.approx(rod_volume_closed_form(ROD, fidelity == "simplified"), rel=1e-6)
 
 

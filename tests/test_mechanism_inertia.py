@@ -88,7 +88,7 @@ def test_four_identical_cylinders_cancel_second_order_force():
     assert np.abs(res8.order_force[1:]).max() < 1e-12 * ref
 
 
-def test_four_star_first_order_resultant_is_constant_two_m_r_omega_squared_along_the_crank():
+def test_four_star_first_order_resultant_is_constant_two_m_r_omega_squared_along_the_crank(oracle):
     # Oracle: seed 000's closed form |F_s1| = 2 m_s r w^2. Summing Table 1 by hand gives
     # F_s1 = 2 m_s r w^2 (sin theta, cos theta), i.e. along the crank. NOTE: the seed prints
     # F_s1x = 2 m_s r w^2 cos(theta), F_s1y = ... sin(theta): x and y swapped with respect to its
@@ -99,6 +99,7 @@ def test_four_star_first_order_resultant_is_constant_two_m_r_omega_squared_along
     f1 = res.order_force[0]
     expected = 2 * ms * R * OMEGA**2 * direction(res.theta)
     assert np.abs(f1 - expected).max() < 1e-12 * ms * R * OMEGA**2
+    oracle(stage="mechanism", quantity="four-star first-order shaking force, N", reference="seed 000 closed form 2 m_s r w^2", tolerance="1e-12", measured=res.scalars["first_order_force_max_n"], expected=2 * ms * R * OMEGA**2)
     assert res.scalars["first_order_force_max_n"] == pytest.approx(2 * ms * R * OMEGA**2, rel=1e-12)
     assert res.scalars["first_order_magnitude_constant"]
     # and a single cylinder is not balanced: the magnitude swings between 0 and m r w^2

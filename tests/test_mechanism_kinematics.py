@@ -39,10 +39,11 @@ def test_series_kinematics_error_scales_like_lambda_cubed():
     assert np.all(errs <= lams[:, None] ** 3)
 
 
-def test_seed_lambda_series_acceleration_within_0p1_percent_of_exact_peak():
+def test_seed_lambda_series_acceleration_within_0p1_percent_of_exact_peak(oracle):
     lam = 25 / 280  # seed 000
     e, s = exact_motion(PSI, R, lam, OMEGA), series_motion(PSI, R, lam, OMEGA)
     peak = R * OMEGA**2 * (1 + lam)  # exact TDC acceleration, closed form
+    oracle(stage="mechanism", quantity="piston acceleration at TDC, seed 000 lambda, m/s^2", reference="closed form r w^2 (1 + lambda)", tolerance="1e-12", measured=e.a.max(), expected=peak)
     assert e.a.max() == pytest.approx(peak, rel=1e-12)
     assert np.abs(e.a - s.a).max() < 1e-3 * peak
 

@@ -14,13 +14,14 @@ from crankmodal.torsion import (
 from crankmodal.torsion.holzer import holzer_residual
 
 
-def test_two_rotor_frequency_matches_closed_form_and_both_solvers():
+def test_two_rotor_frequency_matches_closed_form_and_both_solvers(oracle):
     # omega^2 = k (I1 + I2) / (I1 I2): the textbook two-rotor result, written out here.
     i1, i2, k = 0.8, 3.1, 2.5e5
     f_closed = np.sqrt(k * (i1 + i2) / (i1 * i2)) / (2 * np.pi)
     chain = TorsionalChain([i1, i2], [k])
     assert two_rotor(i1, i2, k).frequency_hz == pytest.approx(f_closed, rel=1e-14)
     assert exact_modes(chain).frequencies_hz[0] == pytest.approx(f_closed, rel=1e-12)
+    oracle(stage="torsion", quantity="two-rotor natural frequency by Holzer, Hz", reference="closed form sqrt(k (I1 + I2) / (I1 I2)) / 2 pi", tolerance="1e-12", measured=holzer(chain).frequencies_hz[0], expected=f_closed)
     assert holzer(chain).frequencies_hz[0] == pytest.approx(f_closed, rel=1e-12)
     assert reduce_to_two_rotors(chain).frequency_hz == pytest.approx(f_closed, rel=1e-14)
 

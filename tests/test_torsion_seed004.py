@@ -49,10 +49,12 @@ def test_journal_polar_moment_eq6():
     assert polar_moment(0.110) * 1e12 == pytest.approx(14373768.14, abs=0.01)
 
 
-def test_two_rotor_306p8_hz_and_node_129p66_mm_from_seed_numbers():
+def test_two_rotor_306p8_hz_and_node_129p66_mm_from_seed_numbers(oracle):
     J = polar_moment(0.110)
     res = two_rotor(I2, I1, G * J / L_EQ, length=L_EQ)
+    oracle(stage="torsion", quantity="seed 004 two-rotor frequency, Hz", reference="seed 004 (published, 306.8 Hz)", tolerance="0.05 Hz", measured=res.frequency_hz, expected=306.8)
     assert res.frequency_hz == pytest.approx(306.8, abs=0.05)
+    oracle(stage="torsion", quantity="seed 004 two-rotor node from the flywheel, mm", reference="seed 004 (published, 129.66 mm)", tolerance="0.005 mm", measured=res.node_from_flywheel_m * 1e3, expected=129.66)
     assert res.node_from_flywheel_m * 1e3 == pytest.approx(129.66, abs=0.005)
     # the seed's own formula f = sqrt(G J / (N2 I2)) / (2 pi) with its N2 = 129.66 mm
     assert math.sqrt(G * J / (0.12966 * I2)) / (2 * math.pi) == pytest.approx(res.frequency_hz, rel=1e-4)
@@ -61,13 +63,14 @@ def test_two_rotor_306p8_hz_and_node_129p66_mm_from_seed_numbers():
     assert exact_modes(chain).nodes[0][0]["position_m"] == pytest.approx(L_EQ - 0.12966, abs=5e-6)
 
 
-def test_seed_holzer_332p6_hz_uses_stiffness_of_node_to_throw_shaft():
+def test_seed_holzer_332p6_hz_uses_stiffness_of_node_to_throw_shaft(oracle):
     J = polar_moment(0.110)
     n2 = L_EQ * I1 / (I1 + I2)
     kt = G * J / (L_EQ - n2)
     assert kt == pytest.approx(1.34411e6, rel=2e-5)  # the table's "KT 134411" (x 10)
     chain = TorsionalChain([0.36172, 2.04661], [kt])
     f = holzer(chain).frequencies_hz[0]
+    oracle(stage="torsion", quantity="seed 004 Holzer root (node-to-throw stiffness), Hz", reference="seed 004 Holzer table (published, 332.6 Hz)", tolerance="0.1 %", measured=f, expected=332.6)
     assert f == pytest.approx(332.6, rel=1e-3)  # 332.81 Hz; the seed took its trial row 2090 rad/s
     # the seed's table row at omega^2 = 4368100 (omega = 2090 rad/s, printed "2080 4388100")
     rows = holzer_table(chain, math.sqrt(4368100.0))
