@@ -38,7 +38,7 @@ class History:
     energy : dict of (K,) arrays, J: kinetic, potential, contact_elastic, work_drive, work_loads,
         work_constraints, dissipated_contact, dissipated_friction, residual; with flexible
         bodies also strain; dissipated_modal (modal damping, integrated with the run).
-    constraint_drift : (K,) max |Phi|, m or rad.
+    constraint_drift : (K,) max ``|Phi|``, m or rad.
     onsets : dict joint -> [(t, v_impact)] contact onsets (s, m/s), every zero crossing.
     separations : dict joint -> [t] contact separations, s.
     angular_acceleration : dict body name -> (K,) rad/s^2 (e.g. the loom's rocker and sley; a
@@ -73,7 +73,7 @@ class History:
     modal: dict = field(default_factory=dict)
 
     def energy_error(self) -> float:
-        """Largest |residual| of the energy balance relative to the energy exchanged in the run
+        """Largest ``|residual|`` of the energy balance relative to the energy exchanged in the run
         (:meth:`energy_scale`), not to the largest energy term: a flywheel's kinetic energy or a
         potential energy with an arbitrary zero would hide a drift of the energy that moves."""
         scale = self.energy_scale()

@@ -136,7 +136,7 @@ def remote_force(points, cells, facets, force, point=None, moment=None) -> np.nd
     """A force (N) and moment (N m) at ``point`` carried to a region by a distributing coupling.
 
     The RBE3-type coupling spreads them with area weights w_a: f_a = w_a (F/W + (J⁻¹ M_c) × r_a),
-    r_a from the weighted centroid c, J = Σ w_a (|r_a|² I − r_a r_aᵀ), M_c the moment about c.
+    r_a from the weighted centroid c, J = Σ w_a (``|r_a|²`` I − r_a r_aᵀ), M_c the moment about c.
     The nodal forces sum to F and their moment about c is M_c, and the region is not stiffened.
     """
     nodes, w = nodal_areas(points, cells, facets)

@@ -44,7 +44,7 @@ class Modes:
     residuals : ndarray, shape (n,)
         ‖Kφ − λMφ‖ / ‖Kφ‖ of each elastic pair.
     orthogonality : float
-        max |ΦᵀMΦ − I| over every returned pair (rigid ones included).
+        max ``|ΦᵀMΦ − I|`` over every returned pair (rigid ones included).
     effective_mass : ndarray, shape (n, 6)
         Effective modal masses for translations x, y, z (kg) and rotations about axes through
         the centre of mass (kg m²).

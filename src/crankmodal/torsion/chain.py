@@ -125,7 +125,7 @@ class TorsionalChain:
 
 
 def normalise_shape(theta: np.ndarray) -> np.ndarray:
-    """Scale a mode shape to max |theta| = 1 with its first non-negligible entry positive."""
+    """Scale a mode shape to max ``|theta|`` = 1 with its first non-negligible entry positive."""
     theta = np.asarray(theta, float)
     theta = theta / np.max(np.abs(theta))
     first = theta[np.argmax(np.abs(theta) > 1e-9)]
@@ -178,7 +178,7 @@ class ChainModes:
     frequencies_hz : ndarray
         Ascending, Hz.
     shapes : ndarray, shape (n_modes, n_rotors)
-        Rotor twist angles, max |theta| = 1.
+        Rotor twist angles, max ``|theta|`` = 1.
     nodes : list of list of dict
         :func:`node_positions` per mode.
     n_rigid : int

@@ -102,7 +102,7 @@ class HolzerResult:
     frequencies_hz : ndarray
         Roots, ascending, Hz (the zero root of a free-free chain left out).
     shapes : ndarray, shape (n_roots, n_rotors)
-        Twist per rotor at each root, max |theta| = 1.
+        Twist per rotor at each root, max ``|theta|`` = 1.
     nodes : list
         :func:`~crankmodal.torsion.chain.node_positions` per root.
     tables : list of list of dict

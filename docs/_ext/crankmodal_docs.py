@@ -1,0 +1,246 @@
+"""Pages generated at build time, so they cannot drift from the code and the tests.
+
+* ``reference/scene.md`` -- every scene section and key from the stages' ``SCHEMA`` dicts
+  (:data:`SCENE_TABLES`): type, default, unit/meaning (the key's ``doc``), bounds and choices.
+* ``validation.md`` -- the oracle table per stage from ``validation/oracles.json``, which the test
+  suite writes (``CRANKMODAL_ORACLES=docs/validation/oracles.json``, see ``tests/conftest.py``).
+* ``gallery/*.ipynb`` -- copies of ``notebooks/*.ipynb`` (Sphinx reads only its source folder;
+  a copy instead of a symlink works on every file system). The notebooks are shown with the
+  outputs they carry (``nb_execution_mode = "off"``).
+
+The generators are pure functions of the repository (``scene_markdown``, ``validation_markdown``)
+so ``tests/test_docs.py`` can check them without building.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import math
+import shutil
+from pathlib import Path
+
+DOCS = Path(__file__).resolve().parents[1]
+ROOT = DOCS.parent
+
+#: (dotted scene table, module, attribute, what it is). Sub-tables follow their parent; a
+#: ``[[...]]`` name is an array of tables.
+SCENE_TABLES: list[tuple[str, str, str, str]] = [
+    ("geometry", "crankmodal.geometry.stage", "SCHEMA",
+     "Parametric crankshaft or connecting rod, STEP or mesh import: [geometry](../guide/geometry.md)."),
+    ("material", "crankmodal.fem.material_stage", "SCHEMA",
+     "Material of the finite-element model: [finite elements](../guide/fem.md)."),
+    ("modal", "crankmodal.fem.modal_stage", "SCHEMA",
+     "Free or supported modes: [finite elements](../guide/fem.md)."),
+    ("static", "crankmodal.fem.static_stage", "SCHEMA",
+     "Supports, loads and a static solve: [finite elements](../guide/fem.md)."),
+    ("reduction", "crankmodal.reduction.stage", "SCHEMA",
+     "Craig-Bampton reduction to a flexible body: [reduction](../guide/reduction.md)."),
+    ("[reduction.interfaces]", "crankmodal.reduction.stage", "INTERFACE_SCHEMA",
+     "One interface (boundary region) of the reduction."),
+    ("torsion", "crankmodal.torsion.stage", "SCHEMA",
+     "Torsional chain and critical speeds: [torsion](../guide/torsion.md)."),
+    ("torsion.throw", "crankmodal.torsion.stage", "THROW_SCHEMA",
+     "Crank-throw dimensions of a chain built from the crank (Ker Wilson)."),
+    ("torsion.flywheel", "crankmodal.torsion.stage", "FLYWHEEL_SCHEMA",
+     "The flywheel of a chain built from the crank."),
+    ("[torsion.segments]", "crankmodal.torsion.stage", "SEGMENT_SCHEMA",
+     "One plain shaft segment of the chain."),
+    ("mechanism", "crankmodal.mechanism.stage", "SCHEMA",
+     "Kinematics, inertia, gas and friction forces: [mechanism](../guide/mechanism.md)."),
+    ("[mechanism.cylinders]", "crankmodal.mechanism.stage", "CYLINDER",
+     "One cylinder (bank) of the machine."),
+    ("mechanism.gas", "crankmodal.mechanism.stage", "GAS",
+     "The gas-pressure model of the cylinders."),
+    ("mechanism.friction", "crankmodal.mechanism.stage", "FRICTION",
+     "Friction of the cylinders and bearings."),
+    ("dynamics", "crankmodal.dynamics.scene_keys", "SCHEMA",
+     "Crank-linkage dynamics with clearance joints: [dynamics](../guide/dynamics.md)."),
+    ("dynamics.crank_train", "crankmodal.dynamics.scene_keys", "CRANK_TRAIN",
+     "Slider-crank and four-star crank trains."),
+    ("dynamics.four_bar", "crankmodal.dynamics.scene_keys", "FOUR_BAR",
+     "The four-bar linkage."),
+    ("[dynamics.clearances]", "crankmodal.dynamics.scene_keys", "CLEARANCE",
+     "One clearance joint."),
+    ("dynamics.contact", "crankmodal.dynamics.scene_keys", "CONTACT",
+     "The normal contact law of the clearance joints."),
+    ("dynamics.friction", "crankmodal.dynamics.scene_keys", "FRICTION",
+     "The friction law of the clearance joints."),
+    ("dynamics.solver", "crankmodal.dynamics.scene_keys", "SOLVER",
+     "The time integrator."),
+    ("dynamics.flexible", "crankmodal.dynamics.scene_keys", "FLEXIBLE",
+     "Flexible (Craig-Bampton) bodies: [flexible bodies](../guide/flexible_bodies.md)."),
+    ("dynamics.flexible.crank / dynamics.flexible.rods", "crankmodal.dynamics.scene_keys",
+     "FLEX_BODY", "A flexible crank or connecting rods of a crank train."),
+    ("dynamics.flexible.crank / .coupler / .rocker (four-bar)", "crankmodal.dynamics.scene_keys",
+     "LINK_BODY", "A flexible link of the four-bar."),
+    ("report", "crankmodal.report.keys", "SCHEMA",
+     "The report of the whole scene: [reports](../guide/reports.md)."),
+]
+
+_TYPE_NAMES = {
+    "float": "number", "int": "integer", "str": "string", "bool": "boolean",
+    "floats": "list of numbers", "ints": "list of integers", "strs": "list of strings",
+    "table": "table", "tables": "list of tables", "any": "any",
+}
+
+
+def schema_tables():
+    """Yield ``(table, description, {key: Field})`` for every entry of :data:`SCENE_TABLES`."""
+    for table, module, attr, what in SCENE_TABLES:
+        yield table, what, getattr(importlib.import_module(module), attr)
+
+
+def _cell(text: str) -> str:
+    return " ".join(str(text).split()).replace("|", "\\|")
+
+
+def _default(field) -> str:
+    from crankmodal.schema import REQUIRED
+    if field.default is REQUIRED:
+        return "**required**"
+    if field.default is None:
+        return "(none)"
+    v = field.default
+    if isinstance(v, float) and (math.isinf(v) or math.isnan(v)):
+        return f"`{v}`"
+    if isinstance(v, str):
+        return f'`"{v}"`'
+    if isinstance(v, bool):
+        return f"`{str(v).lower()}`"
+    if isinstance(v, dict):
+        return "`{}`" if not v else "(table)"
+    return f"`{json.dumps(v) if isinstance(v, (list, tuple)) else v}`"
+
+
+def _allowed(field) -> str:
+    parts = []
+    for name, op in (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<=")):
+        bound = getattr(field, name)
+        if bound is not None:
+            parts.append(f"{op} {bound:g}")
+    if field.choices:
+        parts.append("one of " + ", ".join(f"`{c}`" for c in field.choices))
+    if field.length is not None:
+        parts.append(f"length {field.length}")
+    if field.check is not None:
+        parts.append("checked (see meaning)")
+    return "; ".join(parts) or "-"
+
+
+def _guide_link(page: str, text: str) -> str:
+    """A link into the user guide when the page exists (other pages are written in parallel)."""
+    if (DOCS / "guide" / page).exists():
+        return f"[{text}](../guide/{page})"
+    return text
+
+
+def scene_markdown() -> str:
+    """The scene reference page (MyST Markdown), from the stages' schemas."""
+    lines = [
+        "# Scene reference",
+        "",
+        "Generated from the stages' schemas (`SCHEMA` dicts of `crankmodal.schema.Field`) each "
+        "time the site is built: what is listed here is exactly what `crankmodal check` "
+        "accepts. Units are SI (m, kg, s, N, Pa, rad) unless the key's name or meaning says "
+        "otherwise (`speed_rpm`, `*_deg`, `*_hz`). A `[[name]]` table is an array of tables. "
+        "The sweep file (`SWEEP.toml`) is described in " + _guide_link("sweeps.md", "sweeps") + ".",
+        "",
+        "A scene file holds `name = \"...\"` and one section per stage to run; a section may "
+        "take `machine = \"NAME\"` to pull its defaults from `geometry/NAME.toml`.",
+        "",
+    ]
+    for table, what, schema in schema_tables():
+        what = what.replace("[reports](../guide/reports.md)", _guide_link("reports.md", "reports"))
+        title = f"`[{table}]`" if not table.startswith("[") else f"`[{table}]`"
+        lines += [f"## {title}", "", what, "",
+                  "| key | type | default | allowed | meaning |",
+                  "|---|---|---|---|---|"]
+        for key, f in schema.items():
+            lines.append(f"| `{key}` | {_TYPE_NAMES.get(f.type, f.type)} | {_default(f)} | "
+                         f"{_cell(_allowed(f))} | {_cell(f.doc)} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+STAGE_ORDER = ("geometry", "fem", "reduction", "mechanism", "torsion", "dynamics", "flexible",
+               "report", "sweep")
+
+
+def load_oracles(path: Path | None = None) -> list[dict]:
+    """The oracle rows the tests recorded (``validation/oracles.json``)."""
+    path = path or DOCS / "validation" / "oracles.json"
+    data = json.loads(path.read_text(encoding="utf-8"))
+    return data["oracles"]
+
+
+def _num(x) -> str:
+    if x is None:
+        return "-"
+    if isinstance(x, str):
+        return _cell(x)
+    return f"{x:.6g}"
+
+
+def validation_markdown(rows: list[dict]) -> str:
+    """The validation page: one table per stage of the recorded oracle checks."""
+    stages = sorted({r["stage"] for r in rows},
+                    key=lambda s: (STAGE_ORDER.index(s) if s in STAGE_ORDER else 99, s))
+    lines = [
+        "# Validation",
+        "",
+        "Every number below was written by the test that checks it: the tests call the "
+        "`oracle` fixture (`tests/conftest.py`) with the quantity, its independent reference "
+        "(closed form, published table, peer code, second formulation), the tolerance the test "
+        "asserts and the value it measured. Running the suite with "
+        "`CRANKMODAL_ORACLES=docs/validation/oracles.json` rewrites "
+        "`docs/validation/oracles.json`, from which this page is generated; nothing here is "
+        "typed by hand. The relative error is |measured - expected| / |expected|; where the "
+        "test checks a bound instead of a value, the expected column is empty.",
+        "",
+    ]
+    for stage in stages:
+        lines += [f"## {stage}", "",
+                  "| quantity | reference | expected | measured | rel. error | tolerance | test |",
+                  "|---|---|---|---|---|---|---|"]
+        for r in sorted((r for r in rows if r["stage"] == stage), key=lambda r: r["test"]):
+            exp, meas = r.get("expected"), r["measured"]
+            err = "-"
+            if isinstance(exp, (int, float)) and isinstance(meas, (int, float)) and exp != 0:
+                err = f"{abs(meas - exp) / abs(exp):.2e}"
+            lines.append(
+                f"| {_cell(r['quantity'])} | {_cell(r['reference'])} | {_num(exp)} | "
+                f"{_num(meas)} | {err} | {_cell(r['tolerance'])} | "
+                f"`{_cell(r['test'].split('::', 1)[-1])}` |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _write_if_changed(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.exists() or path.read_text(encoding="utf-8") != text:
+        path.write_text(text, encoding="utf-8")
+
+
+def copy_notebooks(dest: Path) -> list[str]:
+    """Copy ``notebooks/*.ipynb`` into ``dest`` (only when changed); return the names."""
+    dest.mkdir(parents=True, exist_ok=True)
+    names = []
+    for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        target = dest / nb.name
+        if not target.exists() or target.read_bytes() != nb.read_bytes():
+            shutil.copyfile(nb, target)
+        names.append(nb.stem)
+    return names
+
+
+def generate(app=None) -> None:
+    """Write the generated pages into the source folder (before Sphinx reads it)."""
+    _write_if_changed(DOCS / "reference" / "scene.md", scene_markdown())
+    _write_if_changed(DOCS / "validation.md", validation_markdown(load_oracles()))
+    copy_notebooks(DOCS / "gallery" / "notebooks")
+
+
+def setup(app):
+    app.connect("builder-inited", generate)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}
