@@ -99,7 +99,14 @@ def decode_utf8(raw: bytes, path) -> str:
 
 def load_machine(name: str, key: str = "machine") -> dict:
     """The parameter tables of machine ``name`` (SI units), as a dict of tables; ``key`` is the
-    scene key naming it, for the error message."""
+    scene key naming it, for the error message.
+
+    Examples
+    --------
+    >>> import crankmodal as cm
+    >>> sorted(cm.load_machine("four_star_compressor"))
+    ['crankshaft', 'dynamics', 'mechanism', 'rod']
+    """
     return load_toml(machine_path(name, key))
 
 

@@ -107,7 +107,40 @@ def scene_from_dict(
     overrides: list[str] | tuple[str, ...] = (),
     path: Path | None = None,
 ) -> Scene:
-    """Build a :class:`Scene` from a TOML-like dict (the programmatic entry point)."""
+    """Build a :class:`Scene` from a TOML-like dict (the programmatic entry point).
+
+    Parameters
+    ----------
+    data : dict
+        Scene tables as a TOML file would hold them: ``name``, ``description`` and one table per
+        section; a section's ``machine = "NAME"`` pulls its defaults from the machine file.
+    name : str
+        Scene name when ``data`` has none (names the output folder).
+    base_dir : Path or str
+        Folder that relative file names in the scene are resolved against.
+    overrides : sequence of str
+        ``section.key=value`` assignments in TOML syntax, as ``crankmodal run --set``.
+    path : Path, optional
+        The file the scene came from, if any.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        An unknown top-level key, a section that is not a table, an unknown machine or a bad
+        override (the message names the key).
+
+    Examples
+    --------
+    >>> import crankmodal as cm
+    >>> scene = cm.scene_from_dict({"mechanism": {"machine": "four_star_compressor"}},
+    ...                            name="api", overrides=["mechanism.speed_rpm=740"])
+    >>> scene.name, sorted(scene.sections), scene.sections["mechanism"]["speed_rpm"]
+    ('api', ['mechanism'], 740)
+    """
     data = copy.deepcopy(data)
     # A machine named by --set must be known before its defaults are merged; every other
     # override is applied on top of the merged tables, so it can reach into machine lists.

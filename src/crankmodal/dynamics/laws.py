@@ -401,6 +401,27 @@ def _build(registry, kind, name, params):
 def make_law(name: str, params=None) -> NormalLaw:
     """A normal law from its name and a ``law_params`` mapping (unused keys ignored).
 
+    Parameters
+    ----------
+    name : str
+        The law's scene name (``hertz``, ``hunt_crossley``, ``lankarani_nikravesh``, ``flores``,
+        ``kelvin_voigt``, ``johnson_cylinder``, ...).
+    params : mapping, optional
+        Its parameters (``stiffness`` in N/m**exponent, ``exponent``, ``restitution``, ...).
+
+    Returns
+    -------
+    NormalLaw
+
+    Examples
+    --------
+    Hertz's law, ``F = K delta**1.5``: 1 um into a 1e10 N/m**1.5 contact is 10 N.
+
+    >>> import crankmodal as cm
+    >>> law = cm.make_law("hertz", {"stiffness": 1e10, "exponent": 1.5})
+    >>> print(f"{law.force(1e-6, 0.0, 0.0):.6f} N")
+    10.000000 N
+
     Raises
     ------
     ValueError

@@ -217,6 +217,24 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
         re-raises it under its scene key with :class:`crankmodal.errors.scene_keys`).
     NumericalError
         The pairs fail their checks, or the rigid-body count is not the expected one.
+
+    Examples
+    --------
+    A free steel bar 300 x 30 x 20 mm (P2 tetrahedra): six rigid-body modes, and the first
+    bending mode within 2 % of Euler-Bernoulli's ``(4.730 / L)**2 sqrt(E I / (rho A)) / 2 pi``:
+
+    >>> import math
+    >>> import crankmodal as cm
+    >>> from crankmodal.fem import testparts
+    >>> bar = testparts.bar(0.3, 0.03, 0.02, divisions=(12, 2, 2), order=2)
+    >>> steel = cm.material("steel")
+    >>> modes = cm.solve_modes(cm.assemble(bar, steel), n_modes=4)
+    >>> modes.rigid_body_modes
+    6
+    >>> I, A = 0.03 * 0.02**3 / 12, 0.03 * 0.02
+    >>> eb = (4.730 / 0.3)**2 * math.sqrt(steel.E * I / (steel.rho * A)) / (2 * math.pi)
+    >>> bool(abs(modes.frequencies_hz[0] / eb - 1) < 0.02)
+    True
     """
     if n_modes < 1:
         raise ParameterError("n_modes", f"must be >= 1, got {n_modes}")

@@ -174,6 +174,15 @@ def holzer(chain: TorsionalChain, points_per_rotor: int = 400, max_refinements: 
     ------
     NumericalError
         If the expected number of roots is not bracketed after the refinements.
+
+    Examples
+    --------
+    The roots of the Holzer residual are the chain's eigenvalues (:func:`exact_modes`):
+
+    >>> import crankmodal as cm
+    >>> chain = cm.TorsionalChain([0.8, 3.1], [2.5e5])
+    >>> print(f"{cm.holzer(chain).frequencies_hz[0]:.3f} Hz")
+    99.792 Hz
     """
     from scipy.optimize import brentq
 
