@@ -59,7 +59,7 @@ def test_four_star_scene_reproduces_the_seed_balance_and_writes_its_outputs(tmp_
     assert res["summary"].startswith("4 cyl at 1480 rpm")
     for name in res["files"]:
         assert (tmp_path / name).stat().st_size > 0
-    assert len(res["files"]) == 5
+    assert len(res["files"]) == 6  # curves npz + 5 figures (crank torque added, issue 25 #15)
     saved = json.loads((tmp_path / "results.json").read_text())
     assert saved["mechanism"]["gas_work_per_cycle_j"] < 0  # a compressor absorbs work
 

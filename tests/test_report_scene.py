@@ -58,7 +58,7 @@ def test_each_stage_has_its_section_with_verdict_and_every_listed_figure_embedde
     assert len(pngs) >= 3
     # each listed PNG is in its stage's section, byte for byte, in the listed order
     assert _embedded(sec[0]) == [(out / n).read_bytes() for n in pngs]
-    assert htmlmod.escape(f"Verdict: {res[stage]['summary']}") in sec[0]
+    assert htmlmod.escape(f"Summary: {res[stage]['summary']}") in sec[0]
     for w in res[stage].get("warnings") or []:
         assert htmlmod.escape(w) in sec[0]
 

@@ -91,10 +91,12 @@ def run(p: dict, ctx) -> dict:
         res["vtu"] = str(write_modes(ctx.out_dir / "modes.vtu", part.mesh,
                                      modes.frequencies_hz, modes.shapes))
         res["files"] = ["modes.vtu"]  # relative to the output folder (vtu: the full path)
+    from ..report.quantity import quantity_range
+
     f = modes.frequencies_hz
     kind = "free-free" if not sup else f"{len(sup)} supports"
     res["summary"] = (f"{len(f)} elastic modes ({kind}, {modes.rigid_body_modes} rigid), "
-                      f"{f[0]:.1f}-{f[-1]:.1f} Hz; {modes.n_dofs} DOF, "
+                      f"{quantity_range(f[0], f[-1], 'Hz', 5)}; {modes.n_dofs} DOF, "
                       f"{sum(res['timings_s'].get(k, 0.0) for k in ('assembly_total_s', 'reduce_s', 'factorize_s', 'lanczos_s', 'dense_s')):.1f} s"
                       + (" (dense eigensolver)" if modes.eigensolver == "dense" else ""))
     return res

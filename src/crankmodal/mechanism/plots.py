@@ -1,7 +1,9 @@
 """Figures of a :class:`~crankmodal.mechanism.analysis.MechanismResults` (matplotlib, Agg).
 
 ``plot_accelerations`` is seed 000 Fig. 3, ``plot_gas_force`` Fig. 4, ``plot_piston_forces``
-Fig. 5; ``plot_shaking_polar`` is the polar diagram of the shaking force.
+Fig. 5; ``plot_shaking_polar`` is the polar diagram of the shaking force, ``plot_crank_torque``
+the crank torque (rods on the crankshaft, positive in the sense of rotation). Legends list only
+curves that can be seen (:func:`visible_curves`); the others are named in a note.
 """
 
 from __future__ import annotations
@@ -22,16 +24,77 @@ def _labels(res):
             for i, c in enumerate(res.machine.cylinders)]
 
 
+#: a curve whose largest magnitude is below this fraction of the figure's largest is not drawn:
+#: it would lie on the origin (or the axis) where nobody can see it; a note names it instead
+ZERO_FRACTION = 1e-3
+#: a curve within this fraction of the figure's largest magnitude of an already drawn one is
+#: not drawn: it would hide under that one; the note says it coincides
+COINCIDE_FRACTION = 5e-3
+
+
+def visible_curves(curves):
+    """Split labelled curves into those a reader can see and notes on those left out.
+
+    Parameters
+    ----------
+    curves : list of (str, ndarray)
+        Label and data (any shape; compared element by element, in the same unit).
+
+    Returns
+    -------
+    drawn : list of (str, ndarray)
+        Curves to draw (and only these in the legend).
+    hidden : list of str
+        ``'<label> (zero)'`` or ``'<label> (= <other>)'`` for each curve left out.
+    """
+    scale = max((float(np.max(np.abs(c))) for _, c in curves), default=0.0)
+    drawn, hidden = [], []
+    for label, c in curves:
+        c = np.asarray(c, float)
+        if float(np.max(np.abs(c))) <= ZERO_FRACTION * scale:
+            hidden.append(f"{label} (zero)")
+            continue
+        same = next((k for k, d in drawn if d.shape == c.shape
+                     and float(np.max(np.abs(d - c))) <= COINCIDE_FRACTION * scale), None)
+        if same is not None:
+            hidden.append(f"{label} (= {same})")
+            continue
+        drawn.append((label, c))
+    return drawn, hidden
+
+
+def _hidden_note(ax, hidden) -> None:
+    """Name the curves not drawn, in the lower left corner of the axes."""
+    if hidden:
+        ax.text(0.01, 0.01, "not drawn: " + ", ".join(hidden), transform=ax.transAxes,
+                fontsize=7, color="0.3", va="bottom")
+
+
 def plot_accelerations(res, path):
-    """Piston accelerations of all cylinders and rod angular accelerations (seed 000 Fig. 3)."""
+    """Piston accelerations of all cylinders and rod angular accelerations (seed 000 Fig. 3).
+
+    The 2nd-order series is drawn dashed only where it can be seen beside the exact curve;
+    otherwise the title gives its largest difference from the exact one."""
+    from ..report.quantity import percent, quantity
+
     plt = _pyplot()
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    a, a_series = np.asarray(res.a), np.asarray(res.a_series)
+    peak = float(np.max(np.abs(a)))
+    diff = float(np.max(np.abs(a - a_series)))
+    dashed = diff > COINCIDE_FRACTION * peak
     for i, lab in enumerate(_labels(res)):
-        line, = ax1.plot(_deg(res), res.a[:, i], label=lab)
-        ax1.plot(_deg(res), res.a_series[:, i], "--", lw=0.8, color=line.get_color())
+        line, = ax1.plot(_deg(res), a[:, i], label=lab)
+        if dashed:
+            ax1.plot(_deg(res), a_series[:, i], "--", lw=0.8, color=line.get_color())
         ax2.plot(_deg(res), res.beta_ddot[:, i], label=lab)
     ax1.set_ylabel("piston acceleration (m/s$^2$)")
-    ax1.set_title("piston acceleration: exact (solid), 2nd-order series (dashed)")
+    if dashed:
+        ax1.set_title("piston acceleration: exact (solid), 2nd-order series (dashed)")
+    else:
+        ax1.set_title(f"piston acceleration, exact; the 2nd-order series is within "
+                      f"{quantity(diff, 'm/s²', 2)} ({percent(diff / peak, 2)} of the peak)\n"
+                      f"of it and not drawn", fontsize=10)
     ax2.set_ylabel("rod angular acceleration (rad/s$^2$)")
     ax2.set_xlabel("crank angle (deg)")
     _finish(plt, fig, (ax1, ax2), path)
@@ -41,7 +104,8 @@ def _finish(plt, fig, axes, path, grid="major"):
     """Grid and legend on every axis, then write the PNG and free the figure."""
     for ax in axes:
         ax.grid(True, which=grid, alpha=0.3)
-        ax.legend(fontsize=8)
+        if ax.get_legend_handles_labels()[1]:
+            ax.legend(fontsize=8)
     from ..results import savefig_atomic
 
     fig.tight_layout()
@@ -79,31 +143,63 @@ def plot_piston_forces(res, path):
 
 
 def plot_shaking_polar(res, path):
-    """Polar diagram of the shaking force, with and without the counterweight, and per order."""
+    """Polar diagram of the shaking force, with and without the counterweight, and per order.
+
+    Only curves that can be seen are drawn (and listed in the legend); a zero curve (a cancelled
+    order, a fully balanced shaking force) or one lying on another is named in a note."""
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(6, 6))
     curves = [("total", res.shaking_force),
               ("with counterweight", res.shaking_force + res.counterweight_force)]
     curves += [(f"reciprocating order {k + 1}", f) for k, f in enumerate(res.order_force)]
-    for lab, f in curves:
+    drawn, hidden = visible_curves([(lab, np.asarray(f, float) / 1e3) for lab, f in curves])
+    for lab, f in drawn:
         f = np.vstack([f, f[:1]])
-        ax.plot(f[:, 0] / 1e3, f[:, 1] / 1e3, label=lab)
+        ax.plot(f[:, 0], f[:, 1], label=lab)
     ax.plot(0, 0, "k+")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("F$_x$ (kN)")
     ax.set_ylabel("F$_y$ (kN)")
     ax.set_title("shaking force on the frame over one cycle")
+    _hidden_note(ax, hidden)
+    _finish(plt, fig, (ax,), path)
+
+
+def plot_crank_torque(res, path):
+    """Crank torque over the cycle, total and per cylinder, with its mean.
+
+    Sign convention (:mod:`crankmodal.mechanism`): the torque the rods exert on the
+    crankshaft, positive in the sense of rotation (negative on average for a compressor)."""
+    from ..report.quantity import quantity
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    per = np.asarray(res.cylinder_torque, float)
+    curves = [(lab, per[:, i]) for i, lab in enumerate(_labels(res))]
+    drawn, hidden = visible_curves([("total", np.asarray(res.crank_torque, float))] + curves)
+    for lab, t in drawn:
+        ax.plot(_deg(res), t, label=lab, **({"color": "k", "lw": 1.6} if lab == "total"
+                                            else {"lw": 0.8}))
+    mean = float(np.mean(res.crank_torque))
+    ax.axhline(mean, color="k", ls=":", lw=1.0, label=f"mean {quantity(mean, 'N m')}")
+    ax.axhline(0.0, color="0.5", lw=0.6)
+    ax.set_xlabel("crank angle (deg)")
+    ax.set_ylabel("torque of the rods on the crankshaft (N m)\n+ in the sense of rotation")
+    ax.set_title("crank torque (< 0: taken from the crank, as in a compressor)", fontsize=10)
+    _hidden_note(ax, hidden)
     _finish(plt, fig, (ax,), path)
 
 
 def write_all(res, out_dir) -> list[str]:
-    """Write the four figures into ``out_dir``; returns their file names."""
+    """Write the figures into ``out_dir`` (the gas force only with a gas model); returns their
+    file names."""
     out_dir = Path(out_dir)
     figs = {
         "mechanism_accelerations.png": plot_accelerations,
         "mechanism_gas_force.png": plot_gas_force,
         "mechanism_piston_forces.png": plot_piston_forces,
         "mechanism_shaking_polar.png": plot_shaking_polar,
+        "mechanism_crank_torque.png": plot_crank_torque,
     }
     if res.machine.gas is None:  # no working process: no gas force to show
         del figs["mechanism_gas_force.png"]

@@ -190,8 +190,10 @@ def validate(raw: dict, scene=None) -> dict:
 
 
 def _summary(d: dict) -> str:
+    from ..report.quantity import quantity_range
+
     parts = [f"{d['n_cylinders']} cyl at {d['speed_rpm']:g} rpm",
-             f"|F1| {d['first_order_force_min_n']:.0f}..{d['first_order_force_max_n']:.0f} N"]
+             f"|F1| {quantity_range(d['first_order_force_min_n'], d['first_order_force_max_n'], 'N')}"]
     if d["second_order_force_max_n"] is not None:
         parts.append("F2 cancelled" if d["second_order_force_cancelled"]
                      else f"|F2| max {d['second_order_force_max_n']:.0f} N")

@@ -185,7 +185,9 @@ def run(p: dict, ctx) -> dict:
         res["relative_difference"] = rel
         cmp = f"; vs full FE max {np.abs(rel).max() * 100:.2f} % over {k} modes"
     kinds = sorted({i.kind for i in itf})
-    band = f"elastic {fr[0]:.1f}-{fr[-1]:.1f} Hz" if len(fr) else "no elastic mode"
+    from ..report.quantity import quantity_range
+
+    band = f"elastic {quantity_range(fr[0], fr[-1], 'Hz', 5)}" if len(fr) else "no elastic mode"
     res["summary"] = (f"{len(itf)} {'/'.join(kinds)} interfaces, {cb.n_fixed_modes} fixed-interface "
                       f"modes -> {body.n_modes} coordinates; {band}{cmp}; basis {basis_s:.1f} s, "
                       f"{body.n_full_dofs} DOF")

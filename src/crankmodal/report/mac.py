@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .reference import load_reference  # noqa: F401 - re-exported (its old home)
+
 
 def mac_matrix(phi: np.ndarray, psi: np.ndarray) -> np.ndarray:
     """MAC of every pair of columns.
@@ -86,51 +88,3 @@ def sample_at(points: np.ndarray, shapes: np.ndarray, at: np.ndarray,
     kept = np.arange(len(at)) if max_distance is None else np.flatnonzero(dist <= max_distance)
     U = np.asarray(shapes).reshape(len(points), 3, -1)
     return U[idx[kept]].reshape(3 * len(kept), -1), kept
-
-
-def load_reference(path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Reference modes from a file: another crankmodal run's ``modes.vtu``, or an ``.npz``.
-
-    The ``.npz`` holds ``points`` (p, 3) in m, ``shapes`` (3 p, k) node-interleaved or
-    (p, 3, k), and optionally ``frequencies_hz`` (k,) — e.g. test modes at measurement points.
-    In a ``.vtu`` every point array named ``mode_NN_<f>Hz`` (as crankmodal writes them) is one
-    mode.
-
-    Returns
-    -------
-    points : ndarray, shape (p, 3)
-    shapes : ndarray, shape (3 p, k)
-    frequencies_hz : ndarray, shape (k,) (NaN where unknown)
-    """
-    import re
-    from pathlib import Path
-
-    from ..errors import InputFileError
-
-    path = Path(path)
-    if not path.is_file():
-        raise InputFileError(f"report.reference: file not found: {path}")
-    if path.suffix.lower() == ".npz":
-        with np.load(path) as d:
-            if "points" not in d or "shapes" not in d:
-                raise InputFileError(f"report.reference: {path.name} needs arrays 'points' and "
-                                     f"'shapes'")
-            pts = np.asarray(d["points"], float)
-            sh = np.asarray(d["shapes"], float)
-            f = np.asarray(d["frequencies_hz"], float) if "frequencies_hz" in d else None
-        sh = sh.reshape(3 * len(pts), -1)
-        return pts, sh, f if f is not None else np.full(sh.shape[1], np.nan)
-    import meshio
-
-    try:
-        m = meshio.read(path)
-    except Exception as exc:  # noqa: BLE001 - meshio raises many types on bad input
-        raise InputFileError(f"report.reference: cannot read {path.name} ({exc})") from None
-    pat = re.compile(r"mode_(\d+)_([0-9.eE+-]+)Hz")
-    found = sorted((int(g.group(1)), float(g.group(2)), k) for k in m.point_data
-                   if (g := pat.fullmatch(k)))
-    if not found:
-        raise InputFileError(f"report.reference: {path.name} has no point arrays named "
-                             f"mode_NN_<f>Hz")
-    sh = np.column_stack([np.asarray(m.point_data[k], float).reshape(-1) for _, _, k in found])
-    return np.asarray(m.points, float), sh, np.array([f for _, f, _ in found])

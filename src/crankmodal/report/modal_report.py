@@ -11,10 +11,13 @@ from __future__ import annotations
 
 import base64
 import html
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from .quantity import number, percent, quantity
 
 _MIME = {".png": "image/png", ".gif": "image/gif", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
 
@@ -24,8 +27,8 @@ margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
 h1{border-bottom:2px solid #335;padding-bottom:.2em}h2{margin-top:1.8em;color:#335}
 h3{margin-top:1.2em;color:#446}
 table{border-collapse:collapse;margin:.6em 0;font-size:.9em}
-th,td{border:1px solid #bbb;padding:.25em .6em;text-align:right}
-th{background:#eef}td:first-child,th:first-child{text-align:left}
+th,td{border:1px solid #bbb;padding:.25em .6em;text-align:left;vertical-align:top}
+th{background:#eef}td.n{text-align:right;white-space:nowrap}
 figure{margin:1em 0}img{max-width:100%;border:1px solid #ddd}
 figcaption{font-size:.85em;color:#555}.note{color:#555;font-size:.9em}
 """
@@ -65,8 +68,7 @@ class Report:
                 out.append("<table><thead><tr>" + "".join(f"<th>{html.escape(str(h))}</th>"
                                                           for h in b[1]) + "</tr></thead><tbody>")
                 for r in b[2]:
-                    out.append("<tr>" + "".join(f"<td>{html.escape(_cell(c))}</td>" for c in r)
-                               + "</tr>")
+                    out.append("<tr>" + "".join(_html_cell(_cell(c)) for c in r) + "</tr>")
                 out.append("</tbody></table>")
             elif b[0] == "img":
                 mime = _MIME.get(b[1].suffix.lower(), "application/octet-stream")
@@ -88,7 +90,7 @@ class Report:
             elif b[0] == "table":
                 out.append("| " + " | ".join(str(h) for h in b[1]) + " |")
                 out.append("|" + "---|" * len(b[1]))
-                out += ["| " + " | ".join(_cell(c) for c in r) + " |" for r in b[2]]
+                out += ["| " + " | ".join(_md_cell(_cell(c)) for c in r) + " |" for r in b[2]]
                 out.append("")
             elif b[0] == "img":
                 p = b[1]
@@ -102,11 +104,28 @@ class Report:
 
 
 def _cell(c) -> str:
+    """A table cell's text: a dash for a missing value, a plain number (never ``e+04``)."""
     if c is None:
         return "–"
     if isinstance(c, (float, np.floating)):
-        return f"{c:.4g}"
-    return str(c).replace("|", "\\|")  # a literal bar would split the Markdown cell
+        return number(c)
+    return str(c)
+
+
+#: a cell that starts with a number (right-aligned in HTML, so the digits line up)
+_NUMERIC = re.compile(r"^[-+−±<>≈]?\s?\d")
+
+
+def _html_cell(text: str) -> str:
+    """``<td>`` of a cell's text, escaped for HTML; numbers right-aligned, words left."""
+    cls = ' class="n"' if _NUMERIC.match(text) else ""
+    return f"<td{cls}>{html.escape(text)}</td>"
+
+
+def _md_cell(text: str) -> str:
+    """A cell's text for a Markdown table: a literal bar would split the cell, so it is escaped
+    there (and only there: HTML shows ``|F1|`` as it is)."""
+    return text.replace("|", "\\|")
 
 
 def versions() -> dict:
@@ -124,45 +143,65 @@ def versions() -> dict:
     return out
 
 
-def mode_rows(modal: dict) -> list[list]:
-    """Table rows from a ``[modal]`` results dict: frequency, class, effective masses, residual."""
+EFFECTIVE_MASS_KEYS = ("x_kg", "y_kg", "z_kg", "rx_kgm2", "ry_kgm2", "rz_kgm2")
+EFFECTIVE_MASS_HEADER = ["m_eff x, kg", "m_eff y, kg", "m_eff z, kg", "J_eff x, kg m²",
+                         "J_eff y, kg m²", "J_eff z, kg m²"]
+MODE_HEADER = ["mode", "frequency, Hz", "class", *EFFECTIVE_MASS_HEADER, "residual"]
+
+
+def carries_effective_mass(modal: dict) -> bool:
+    """Whether any elastic mode has an effective mass above round-off (1e-9 of the total).
+
+    A free-free part's elastic modes carry none: its rigid-body modes take the whole mass, so
+    the effective-mass columns would be zeros only."""
+    em = modal.get("effective_mass") or {}
+    floor = 1e-9 * modal.get("total_mass_kg", 0.0)
+    return any(abs(v) > floor for c in EFFECTIVE_MASS_KEYS for v in em.get(c, ()))
+
+
+def mode_rows(modal: dict, effective_mass: bool = True) -> list[list]:
+    """Table rows from a ``[modal]`` results dict: frequency, class, effective masses (with
+    ``effective_mass``; see :data:`MODE_HEADER`), residual."""
     f = modal["frequencies_hz"]
     classes = modal.get("classes") or [None] * len(f)
     em = modal.get("effective_mass", {})
-    keys = ("x_kg", "y_kg", "z_kg", "rx_kgm2", "ry_kgm2", "rz_kgm2")
     res = modal.get("residuals") or [None] * len(f)
     # effective masses below 1e-9 of the total are round-off (free-free elastic modes carry none)
     floor = 1e-9 * modal.get("total_mass_kg", 0.0)
 
     def fmt(v):
-        return "0" if abs(v) <= floor else f"{v:.3g}"
+        return "0" if abs(v) <= floor else number(v, 3)
 
     rows = []
     for k in range(len(f)):
         rows.append([k + 1, f"{f[k]:.2f}", classes[k]]
-                    + [fmt(em[c][k]) if c in em else None for c in keys]
+                    + ([fmt(em[c][k]) if c in em else None for c in EFFECTIVE_MASS_KEYS]
+                       if effective_mass else [])
                     + [f"{res[k]:.1e}" if res[k] is not None else None])
     return rows
 
 
-MODE_HEADER = ["mode", "frequency, Hz", "class", "m_eff x, kg", "m_eff y, kg", "m_eff z, kg",
-               "J_eff x, kg m²", "J_eff y, kg m²", "J_eff z, kg m²", "residual"]
-
-
-def measured_rows(frequencies_hz, measured_hz) -> list[list]:
-    """Rows: mode, measured Hz, computed Hz, difference % (computed vs measured)."""
+def measured_rows(frequencies_hz, measured_hz, tolerance: float) -> list[list]:
+    """Rows: mode, measured Hz, computed Hz, difference (computed vs measured), and the verdict
+    against ``tolerance`` (admissible ``|f - f_measured| / f_measured``)."""
     from .testing import compare_frequencies
 
+    tol = percent(tolerance)
     return [[r["mode"], f"{r['expected_hz']:.1f}",
              None if r["computed_hz"] is None else f"{r['computed_hz']:.1f}",
-             None if r["rel_error"] is None else f"{100 * r['rel_error']:+.2f} %"]
-            for r in compare_frequencies(frequencies_hz, measured_hz, rtol=1.0)]
+             None if r["rel_error"] is None else percent(r["rel_error"], sign=True),
+             ("not computed" if r["computed_hz"] is None
+              else f"{'within' if r['ok'] else 'OUTSIDE'} ±{tol}")]
+            for r in compare_frequencies(frequencies_hz, measured_hz, rtol=tolerance)]
+
+
+MEASURED_HEADER = ["mode", "measured, Hz", "computed, Hz", "difference", "verdict"]
 
 
 def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
                  renders: dict | None = None, mac: dict | None = None,
-                 measured_hz=None, timings: dict | None = None, extra_images=(),
-                 level: int = 2, versions_table: bool = True) -> Report:
+                 measured_hz=None, tolerance: float = 0.05, timings: dict | None = None,
+                 extra_images=(), level: int = 2, versions_table: bool = True) -> Report:
     """Fill a report with the standard modal content.
 
     Parameters
@@ -174,6 +213,9 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
     mac : dict, optional
         ``matrix``, ``image``, ``source``, ``pairs``.
     measured_hz : sequence, optional
+        Hz by mode (None where nothing was measured).
+    tolerance : float
+        Admissible relative difference from the measured frequencies (the verdict column).
     timings : dict, optional
         Section -> wall time, s.
     extra_images : iterable of (path, caption)
@@ -219,14 +261,23 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
         report.paragraph(f"Free-free: {modal.get('rigid_body_modes')} rigid-body modes found "
                          f"and left out.")
     heading("Natural frequencies and mode shapes")
-    report.table(MODE_HEADER, mode_rows(modal))
+    held = carries_effective_mass(modal)
+    header = MODE_HEADER if held else [h for h in MODE_HEADER if h not in EFFECTIVE_MASS_HEADER]
+    report.table(header, mode_rows(modal, effective_mass=held))
+    masses = ("Effective masses: translations in kg, rotations about the centre of mass in kg m²."
+              if held else
+              f"No effective-mass columns: the part is free-free, and its "
+              f"{modal.get('rigid_body_modes')} rigid-body modes carry the whole mass, so every "
+              f"elastic mode's effective mass is zero (to round-off).")
     report.paragraph(f"Largest eigen-residual ‖Kφ − λMφ‖/‖Kφ‖: {modal.get('residual_max', 0):.1e}; "
-                     f"M-orthogonality defect {modal.get('m_orthogonality_max', 0):.1e}. Effective "
-                     f"masses: translations in kg, rotations about the centre of mass in kg m².")
+                     f"M-orthogonality defect {modal.get('m_orthogonality_max', 0):.1e}. "
+                     + masses)
     if measured_hz:
         heading("Comparison with measured frequencies")
-        report.table(["mode", "measured, Hz", "computed, Hz", "difference"],
-                     measured_rows(modal["frequencies_hz"], measured_hz))
+        report.paragraph(f"Verdict per mode: the difference from the measured frequency "
+                         f"against the tolerance ±{percent(tolerance)} (report.tolerance).")
+        report.table(MEASURED_HEADER, measured_rows(modal["frequencies_hz"], measured_hz,
+                                                    tolerance))
     if mac:
         heading("MAC against the reference modes")
         report.paragraph(f"Reference: {mac['source']}. Pairs (mode ↔ reference, MAC): "
@@ -235,21 +286,29 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
             report.image(mac["image"], "MAC matrix")
     if renders:
         heading("Mode-shape renders")
-        if renders.get("sheet"):
-            report.image(renders["sheet"], "All modes (same camera)")
-        for p in renders.get("modes", []):
-            report.image(p, Path(p).stem.replace("_", " "))
-        for p in renders.get("gifs", []):
-            report.image(p, Path(p).stem.replace("_", " ") + " (animated)")
+        for path, caption in render_images(renders):
+            report.image(path, caption)
     for path, caption in extra_images:
         report.image(path, caption)
     if timings:
         heading("Timings")
-        report.table(["step", "wall time, s"], [[k, f"{v:.3g}"] for k, v in timings.items()])
+        report.table(["step", "wall time"], [[k, quantity(v, "s", 3)] for k, v in timings.items()])
     if versions_table:
         heading("Versions")
         report.table(["package", "version"], [[k, v] for k, v in versions().items()])
     return report
+
+
+def render_images(renders: dict) -> list[tuple[Path, str]]:
+    """The pictures that show each rendered mode once: one animation per mode when there are
+    GIFs, else the contact sheet (all modes, one camera), else the single still."""
+    if renders.get("gifs"):
+        return [(Path(p), Path(p).stem.replace("_", " ") + " (animated)")
+                for p in renders["gifs"]]
+    if renders.get("sheet"):
+        return [(Path(renders["sheet"]), ("All modes (same camera; each mode also as "
+                                          "mode_NN.png beside the report)"))]
+    return [(Path(p), Path(p).stem.replace("_", " ")) for p in renders.get("modes", [])]
 
 
 def write_report(report: Report, out_dir, stem: str = "report") -> dict:

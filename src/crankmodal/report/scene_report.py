@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .modal_report import _MIME, Report
+from .quantity import percent, quantities, quantity, quantity_range
 
 #: sections drawn by :func:`crankmodal.report.modal_report.modal_blocks` (the FE part's modes)
 MODAL_SECTIONS = ("geometry", "material", "modal")
@@ -53,7 +54,8 @@ def scene_title(scene, params: dict, results: dict) -> str:
 
 def fmt(v, unit: str = "", scale: float = 1.0, digits: int = 4) -> str | None:
     """A number (or a list of numbers) for a table cell, scaled, with ``digits`` significant
-    digits and the unit; None (shown as a dash) for a missing value."""
+    digits and the unit (:mod:`.quantity`: an SI unit takes an engineering prefix, ``15.99 kN``;
+    never ``e+04``); None (shown as a dash) for a missing value."""
     if v is None:
         return None
     if isinstance(v, bool):
@@ -61,19 +63,22 @@ def fmt(v, unit: str = "", scale: float = 1.0, digits: int = 4) -> str | None:
     if isinstance(v, (list, tuple)):
         if not v:
             return None
-        return ", ".join(fmt(x, "", scale, digits) or "–" for x in v) + (f" {unit}" if unit else "")
+        return quantities([None if x is None else x * scale for x in v], unit, digits)
     if isinstance(v, int) and scale == 1.0:
         return str(v) + (f" {unit}" if unit else "")
     if isinstance(v, (int, float)):
-        return f"{v * scale:.{digits}g}" + (f" {unit}" if unit else "")
+        return quantity(v * scale, unit, digits)
     return str(v)
 
 
 def verdict(report: Report, res: dict, label: str | None = None) -> None:
     """The stage's one-line summary and each of its warnings as paragraphs (``label``: the
-    section's name, where one heading covers several sections)."""
+    section's name, where one heading covers several sections).
+
+    A summary states numbers; it is labelled "Summary". "Verdict" is kept for comparisons
+    with a stated tolerance (measured frequencies, critical-speed margins)."""
     if res.get("summary"):
-        report.paragraph(f"Verdict{f' [{label}]' if label else ''}: {res['summary']}")
+        report.paragraph(f"Summary{f' [{label}]' if label else ''}: {res['summary']}")
     for w in res.get("warnings") or []:
         report.paragraph(f"Warning: {w}")
 
@@ -139,7 +144,7 @@ def _rows(res: dict, spec) -> list[list]:
 
 MECHANISM_KINEMATICS = (
     ("n_cylinders", "cylinders", "", 1.0), ("speed_rpm", "speed", "rpm", 1.0),
-    ("crank_radius_m", "crank radius", "mm", 1e3), ("rod_length_m", "rod length", "mm", 1e3),
+    ("crank_radius_m", "crank radius", "m", 1.0), ("rod_length_m", "rod length", "m", 1.0),
     ("crank_rod_ratio", "crank / rod ratio λ", "", 1.0),
     ("bank_angles_deg", "bank angles", "°", 1.0),
     ("reciprocating_mass_kg", "reciprocating mass", "kg", 1.0),
@@ -170,11 +175,33 @@ MECHANISM_FORCES = (
     ("peak_rod_force_n", "peak rod force", "N", 1.0),
     ("friction_work_per_cycle_j", "friction work per cycle", "J", 1.0),
     ("gas_work_per_cycle_j", "gas work per cycle", "J", 1.0),
-    ("indicated_power_w", "indicated power", "kW", 1e-3),
-    ("mean_crank_torque_nm", "crank torque, mean", "N m", 1.0),
-    ("max_crank_torque_nm", "crank torque, max", "N m", 1.0),
-    ("min_crank_torque_nm", "crank torque, min", "N m", 1.0),
+    ("indicated_power_w", "indicated power", "W", 1.0),
+    ("mean_crank_torque_nm", "crank torque on the crankshaft, mean (+ in the sense of rotation)",
+     "N m", 1.0),
+    ("max_crank_torque_nm", "crank torque on the crankshaft, max", "N m", 1.0),
+    ("min_crank_torque_nm", "crank torque on the crankshaft, min", "N m", 1.0),
 )
+
+#: the crank torque's sign, as :mod:`crankmodal.mechanism` defines it
+CRANK_TORQUE_CONVENTION = ("Sign convention: the crank torque is the torque the connecting rods "
+                           "exert on the crankshaft, positive in the sense of rotation. It is "
+                           "positive on average for an engine and negative for a compressor, "
+                           "whose drive supplies the opposite torque.")
+
+
+def crank_torque_note(res: dict) -> str | None:
+    """The sign convention and what this run's mean crank torque means under it; None when
+    the results carry no crank torque."""
+    mean = res.get("mean_crank_torque_nm")
+    if mean is None:
+        return None
+    if mean < 0:
+        what = (f"here the mean {quantity(mean, 'N m')} is taken from the crank: the drive "
+                f"delivers {quantity(-mean, 'N m')} on average")
+    else:
+        what = (f"here the mean {quantity(mean, 'N m')} is delivered to the crank (the machine "
+                f"drives)")
+    return f"{CRANK_TORQUE_CONVENTION} {what[0].upper()}{what[1:]}."
 
 
 def mechanism_blocks(report: Report, res: dict) -> None:
@@ -186,6 +213,9 @@ def mechanism_blocks(report: Report, res: dict) -> None:
         if rows:
             report.heading(name, level=3)
             report.table(["quantity", "value"], rows)
+    note = crank_torque_note(res)
+    if note:
+        report.paragraph(note)
 
 
 def torsion_blocks(report: Report, res: dict) -> None:
@@ -204,25 +234,32 @@ def torsion_blocks(report: Report, res: dict) -> None:
     best = crit.get("nearest_to_operating")
     if best and best not in near:
         near.insert(0, best)
+    required = crit.get("required_margin", 0.0)
+    rng = crit.get("speed_range_rpm") or []
     report.heading("Critical speeds", level=3)
-    report.paragraph(f"Operating speed {fmt(crit.get('operating_speed_rpm'), 'rpm')}, required "
-                     f"margin {fmt(100 * crit.get('required_margin', 0.0), '%', digits=3)}; "
+    report.paragraph(f"Operating speed {fmt(crit.get('operating_speed_rpm'), 'rpm')}; "
                      f"{len(crit.get('critical_speeds_in_range') or [])} critical speeds in "
-                     f"{fmt(crit.get('speed_range_rpm'), 'rpm')}. Within the margin (or nearest):")
-    report.table(["mode", "natural, Hz", "order", "critical speed, rpm", "margin"],
+                     + (quantity_range(rng[0], rng[1], "rpm") if len(rng) == 2 else "the range")
+                     + f". Verdict per critical speed: its margin from the operating speed "
+                     f"against the required ±{percent(required)} (torsion.required_margin). "
+                     f"Those within the margin (or the nearest):")
+    report.table(["mode", "natural, Hz", "order", "critical speed, rpm", "margin", "verdict"],
                  [[c.get("mode"), fmt(c.get("natural_hz")), fmt(c.get("order")),
                    fmt(c.get("speed_rpm")),
-                   None if c.get("margin") is None else f"{100 * c['margin']:+.2f} %"]
+                   None if c.get("margin") is None else percent(c["margin"], sign=True),
+                   None if c.get("margin") is None else
+                   (f"INSIDE ±{percent(required)}" if abs(c["margin"]) <= required
+                    else f"clear of ±{percent(required)}")]
                   for c in near])
 
 
 def static_blocks(report: Report, res: dict) -> None:
     """Peak stresses, displacement and safety factors of the static load case."""
-    rows = _rows(res, (("max_von_mises_pa", "max von Mises", "MPa", 1e-6),
-                       ("max_von_mises_location_m", "at", "mm", 1e3),
-                       ("max_principal_pa", "max principal", "MPa", 1e-6),
-                       ("min_principal_pa", "min principal", "MPa", 1e-6),
-                       ("max_displacement_m", "max displacement", "µm", 1e6),
+    rows = _rows(res, (("max_von_mises_pa", "max von Mises", "Pa", 1.0),
+                       ("max_von_mises_location_m", "at", "m", 1.0),
+                       ("max_principal_pa", "max principal", "Pa", 1.0),
+                       ("min_principal_pa", "min principal", "Pa", 1.0),
+                       ("max_displacement_m", "max displacement", "m", 1.0),
                        ("safety_factor_yield", "safety factor, yield", "", 1.0),
                        ("safety_factor_ultimate", "safety factor, ultimate", "", 1.0),
                        ("reaction_n", "reaction", "N", 1.0), ("n_dofs", "DOF", "", 1.0)))
@@ -391,14 +428,14 @@ def stage_section(report: Report, section: str, res: dict, out_dir: Path,
 
 
 def overview_rows(results: dict) -> list[list]:
-    """One row per stage: section, wall time, verdict (summary, and the number of warnings)."""
+    """One row per stage: section, wall time, summary (and the number of warnings)."""
     rows = []
     for s, r in results.items():
         if not isinstance(r, dict):
             continue
         n_w = len(r.get("warnings") or [])
         text = r.get("summary", "") + (f" ({n_w} warning{'s' * (n_w > 1)})" if n_w else "")
-        rows.append([f"[{s}]", f"{r.get('wall_time_s', 0.0):.3g}", text])
+        rows.append([f"[{s}]", quantity(r.get("wall_time_s", 0.0), "s", 3), text])
     return rows
 
 

@@ -55,6 +55,7 @@ SCHEMA: dict[str, Field] = {
     "operating_speed_rpm": Field("float", None, "operating speed, rpm", gt=0.0),
     "required_margin": Field("float", 0.10, "separation wanted between critical and operating speed (fraction)",
                              ge=0.0, lt=1.0),
+    "forced": Field("table", None, "steady-state forced response of the chain (see forced_stage.SCHEMA)"),
 }
 
 THROW_SCHEMA: dict[str, Field] = {
@@ -179,7 +180,11 @@ def validate(raw: dict, scene) -> dict:
 
     with scene_keys(SECTION):
         excitation_orders(p["order_type"], p["max_order"])
-    build(p)
+    chain, model = build(p)
+    if p["forced"] is not None:
+        from .forced_stage import validate as validate_forced
+
+        p["forced"] = validate_forced(p, scene, chain, model)
     return p
 
 
@@ -242,6 +247,11 @@ def run(p: dict, ctx) -> dict:
     }
     if model is not None:
         res["crank_model"] = model.to_dict()
+    if p["forced"] is not None:
+        from .forced_stage import run as run_forced
+
+        res["forced"] = run_forced(p["forced"], ctx, chain)
+        res["files"] += res["forced"]["files"]
     beside = beside_cad_and_fe(res, ctx, p["n_throws"])
     if beside:
         res.update(beside)
@@ -304,6 +314,8 @@ def _summary(res: dict, crit) -> str:
     if res["two_rotor_hz"] is not None:
         s += f", two-rotor {res['two_rotor_hz']:.4g} Hz"
     near = crit.nearest() if crit is not None else None
+    if res.get("forced"):
+        s += "; forced: " + res["forced"]["summary"]
     if near is not None:
         s += (f"; nearest critical {near['speed_rpm']:.5g} rpm (mode {near['mode']}, order {near['order']:g}, "
               f"{100 * near['margin']:+.1f} % of operating)")
