@@ -163,3 +163,29 @@ def cycle_work(pressure, volume) -> float:
     v = np.asarray(volume)
     dv = np.roll(v, -1) - v
     return float(np.sum(0.5 * (p + np.roll(p, -1)) * dv))
+
+
+def tabulated_pressure(alpha, angles, pressures, period: float):
+    """Cylinder pressure (Pa) interpolated in a measured or digitised table, periodic.
+
+    Parameters
+    ----------
+    alpha : array_like
+        Crank angle (rad) in the table's reference (firing TDC for a four-stroke engine, top dead
+        centre otherwise), any range (taken modulo ``period``).
+    angles : array_like
+        Table crank angles (rad), strictly increasing, spanning exactly one ``period``: the last
+        point is the first one a cycle later (a closed cycle).
+    pressures : array_like
+        Absolute pressures at ``angles`` (Pa); the first and last are equal.
+    period : float
+        Length of the working cycle (rad): 2 pi or 4 pi.
+
+    Returns
+    -------
+    ndarray
+        Linear interpolation of the table at ``alpha``.
+    """
+    angles = np.asarray(angles, dtype=float)
+    a = angles[0] + np.mod(np.asarray(alpha, dtype=float) - angles[0], period)
+    return np.interp(a, angles, np.asarray(pressures, dtype=float))

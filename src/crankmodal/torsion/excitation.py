@@ -1,0 +1,327 @@
+"""Tangential effort of each cylinder on its throw, and its orders, from the machine's mechanism.
+
+The torque of a cylinder on the crankshaft over one working cycle comes from
+:func:`crankmodal.mechanism.analysis.analyse` (exact kinematics, gas cycle, reciprocating and
+rotating masses, rod inertia couple, piston friction): nothing here recomputes it. At constant
+speed ``omega`` the cylinder torque splits into a part that does not depend on speed (gas
+pressure; Coulomb piston friction, whose amplitude the mechanism fixes from the indicated power
+per revolution) and the inertia part, proportional to ``omega^2``::
+
+    T(theta; omega) = T_gas(theta) + omega^2 T_inertia,1(theta)
+
+so two mechanism cycles (with gas at the machine's speed, and without gas at 1 rad/s) give the
+excitation at every speed. A measured or digitised cylinder-pressure table replaces the gas model
+(:func:`crankmodal.mechanism.gas.tabulated_pressure`; no piston friction then).
+
+Orders: the working cycle lasts ``cycle_revolutions`` turns (2 for four-stroke), so harmonic ``k``
+of the cycle is order ``q = k / cycle_revolutions`` of the shaft speed (half orders for
+four-stroke). Convention: ``T(theta) = T_mean + sum_q Re(c_q exp(i q theta))``, theta the
+reference crank angle (``theta = omega t``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+
+
+@dataclass(frozen=True)
+class PressureTable:
+    """A measured or digitised cylinder pressure over one closed cycle.
+
+    Attributes
+    ----------
+    angles : ndarray
+        Crank angle from firing TDC (four-stroke) or from top dead centre (rad), strictly
+        increasing, the last one cycle after the first.
+    pressures : ndarray
+        Absolute pressure (Pa), last equal to first.
+    cycle_revolutions : int
+        1 (360 deg cycle) or 2 (720 deg).
+
+    Raises
+    ------
+    ParameterError
+        ``angle_deg`` not strictly increasing or not spanning one cycle, ``pressure_pa`` of the
+        wrong length, negative, or not closed (last != first).
+    """
+
+    angles: np.ndarray
+    pressures: np.ndarray
+    cycle_revolutions: int
+
+    def __post_init__(self):
+        a = np.asarray(self.angles, float)
+        p = np.asarray(self.pressures, float)
+        object.__setattr__(self, "angles", a)
+        object.__setattr__(self, "pressures", p)
+        if self.cycle_revolutions not in (1, 2):
+            raise ParameterError("cycle_deg", "must be 360 or 720")
+        if a.ndim != 1 or len(a) < 3:
+            raise ParameterError("angle_deg", f"needs at least 3 points, got {a.size}")
+        if p.shape != a.shape:
+            raise ParameterError("pressure_pa", f"needs one pressure per angle ({len(a)}), got {p.size}")
+        if not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0.0):
+            i = int(np.argmax(~(np.diff(a) > 0.0))) if np.all(np.isfinite(a)) else 0
+            raise ParameterError("angle_deg", f"must be strictly increasing; entry {i + 1} "
+                                 f"({math.degrees(a[i + 1]):g} deg) does not exceed entry {i} "
+                                 f"({math.degrees(a[i]):g} deg)")
+        span = 2.0 * math.pi * self.cycle_revolutions
+        if abs(a[-1] - a[0] - span) > 1e-9 * span:
+            raise ParameterError(
+                "angle_deg", f"must close the cycle: last - first = {math.degrees(span):g} deg, got "
+                f"{math.degrees(a[-1] - a[0]):g} deg (repeat the first point one cycle later)")
+        if not np.all(np.isfinite(p)) or np.any(p < 0.0):
+            raise ParameterError("pressure_pa", "must be absolute pressures >= 0 and finite")
+        if abs(p[-1] - p[0]) > 1e-9 * max(abs(p[0]), 1.0):
+            raise ParameterError("pressure_pa", f"must close the cycle: last ({p[-1]:g} Pa) must "
+                                 f"equal first ({p[0]:g} Pa)")
+
+    def pressure(self, alpha):
+        """Absolute pressure (Pa) at crank angles ``alpha`` (rad) of the table's reference."""
+        from ..mechanism.gas import tabulated_pressure
+
+        return tabulated_pressure(alpha, self.angles, self.pressures,
+                                  2.0 * math.pi * self.cycle_revolutions)
+
+
+@dataclass
+class CylinderEfforts:
+    """Crank torque of each cylinder over one working cycle, split by speed dependence.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (n,)
+        Reference crank angle over one working cycle (rad), uniform, periodic.
+    cycle_revolutions : int
+    crank_radius : float
+        (m)
+    gas_torque : ndarray, shape (n, n_cyl)
+        Speed-independent torque on the crank (gas, piston friction) (N m).
+    inertia_torque_unit : ndarray, shape (n, n_cyl)
+        Inertia torque at 1 rad/s (N m s^2); at ``omega`` it is ``omega^2`` times this.
+    cylinder_throws : ndarray of int
+        0-based throw of each cylinder.
+    """
+
+    theta: np.ndarray
+    cycle_revolutions: int
+    crank_radius: float
+    gas_torque: np.ndarray
+    inertia_torque_unit: np.ndarray
+    cylinder_throws: np.ndarray
+
+    @property
+    def n_cylinders(self) -> int:
+        return self.gas_torque.shape[1]
+
+    def torque(self, omega: float) -> np.ndarray:
+        """Cylinder torques at speed ``omega`` (rad/s), shape (n, n_cyl), N m."""
+        return self.gas_torque + omega**2 * self.inertia_torque_unit
+
+    def tangential_effort(self, omega: float) -> np.ndarray:
+        """Tangential force on each crankpin ``T / r`` (N), shape (n, n_cyl)."""
+        return self.torque(omega) / self.crank_radius
+
+    def harmonic_indices(self, max_order: float) -> np.ndarray:
+        """Cycle harmonics ``k = 1 .. max_order x cycle_revolutions``."""
+        kmax = int(math.floor(max_order * self.cycle_revolutions + 1e-9))
+        if kmax < 1:
+            raise ParameterError("max_order", f"must be >= {1 / self.cycle_revolutions:g}, got {max_order}")
+        if 2 * kmax >= len(self.theta):
+            raise ParameterError("max_order", f"needs more samples per cycle than {len(self.theta)}")
+        return np.arange(1, kmax + 1)
+
+    def orders(self, max_order: float) -> np.ndarray:
+        """Orders ``q = k / cycle_revolutions`` up to ``max_order``."""
+        return self.harmonic_indices(max_order) / self.cycle_revolutions
+
+    def cylinder_harmonics(self, max_order: float) -> tuple[np.ndarray, np.ndarray]:
+        """Complex order coefficients of the gas part and of the unit inertia part.
+
+        Returns
+        -------
+        gas, inertia_unit : ndarray, shape (n_orders, n_cyl), complex
+            ``c_q`` with ``T = mean + sum Re(c_q exp(i q theta))``; N m and N m s^2.
+        """
+        k = self.harmonic_indices(max_order)
+        n = len(self.theta)
+        g = np.fft.rfft(self.gas_torque, axis=0)[k] * (2.0 / n)
+        h = np.fft.rfft(self.inertia_torque_unit, axis=0)[k] * (2.0 / n)
+        return g, h
+
+    def mean_torque(self, omega: float = 0.0) -> np.ndarray:
+        """Mean torque of each cylinder over the cycle (N m); the inertia part's mean is zero."""
+        return self.torque(omega).mean(axis=0)
+
+
+def cylinder_efforts(machine, arrangement=None, pressure_table: PressureTable | None = None,
+                     n_per_rev: int = 720) -> CylinderEfforts:
+    """Each cylinder's crank torque over one working cycle, from the mechanism.
+
+    Parameters
+    ----------
+    machine : crankmodal.mechanism.machine.Machine
+        Its speed is where the gas part is evaluated (the gas part does not depend on speed).
+    arrangement : crankmodal.mechanism.arrangement.Arrangement, optional
+        Throw angles and firing order applied to the machine's cylinders first.
+    pressure_table : PressureTable, optional
+        Replaces the machine's gas model for every cylinder (four-stroke: relative to each
+        cylinder's firing TDC).
+    n_per_rev : int
+        Crank-angle samples per revolution.
+
+    Returns
+    -------
+    CylinderEfforts
+    """
+    from ..mechanism import forces as fo
+    from ..mechanism import gas as ga
+    from ..mechanism.analysis import analyse
+    from ..mechanism.kinematics import kinematic_ratio
+
+    if n_per_rev < 36:
+        raise ParameterError("n_per_rev", f"must be >= 36, got {n_per_rev}")
+    if arrangement is not None:
+        machine = arrangement.apply(machine)
+        throws = np.asarray(arrangement.cylinder_throws, int)
+        cr = arrangement.cycle_revolutions
+    else:
+        throws = np.arange(len(machine.cylinders))
+        cr = machine.cycle_revolutions
+    if pressure_table is not None:
+        cr = pressure_table.cycle_revolutions
+    n = n_per_rev * cr
+    theta = 2.0 * math.pi * cr * np.arange(n) / n
+
+    unit = dataclasses.replace(machine, gas=None, friction=None, speed_rpm=30.0 / math.pi)
+    inertia = np.tile(analyse(unit, n_per_rev).cylinder_torque, (cr, 1))  # 1 rad/s, one turn
+
+    cyl = machine.cylinders
+    if pressure_table is not None:
+        gamma = np.array([c.throw_angle for c in cyl])
+        phi = np.array([c.bank_angle for c in cyl])
+        psi = theta[:, None] + gamma - phi
+        phase = np.array([c.cycle_phase for c in cyl]) if cr == 2 else 0.0
+        p = pressure_table.pressure(psi - phase)
+        area = np.array([c.area for c in cyl])
+        force = ga.gas_force(p, area, machine.atmospheric_pressure)
+        gas = fo.crank_torque(force, kinematic_ratio(psi, machine.crank_radius, machine.ratio))
+    elif machine.gas is None:
+        gas = np.zeros_like(inertia)
+    else:
+        if machine.cycle_revolutions != cr:
+            raise ParameterError("cycle_revolutions", f"the machine's gas model has a "
+                                 f"{360 * machine.cycle_revolutions} deg cycle, not {360 * cr} deg")
+        full = analyse(machine, n_per_rev).cylinder_torque
+        gas = full - machine.omega**2 * inertia
+    return CylinderEfforts(theta=theta, cycle_revolutions=cr, crank_radius=machine.crank_radius,
+                           gas_torque=gas, inertia_torque_unit=inertia, cylinder_throws=throws)
+
+
+def throw_to_rotor_matrix(cylinder_throws, throw_rotors, n_rotors: int) -> np.ndarray:
+    """Incidence matrix ``P`` (n_rotors, n_cyl): rotor torque = ``P @`` cylinder torque.
+
+    Parameters
+    ----------
+    cylinder_throws : sequence of int
+        0-based throw of each cylinder.
+    throw_rotors : sequence of int
+        0-based rotor of each throw.
+    n_rotors : int
+
+    Raises
+    ------
+    ParameterError
+        ``throw_rotors`` of the wrong length or naming a rotor that does not exist.
+    """
+    cylinder_throws = np.asarray(cylinder_throws, int)
+    n_thr = int(cylinder_throws.max()) + 1
+    if len(throw_rotors) != n_thr:
+        raise ParameterError("throw_rotors", f"needs one rotor per throw ({n_thr}), got {len(throw_rotors)}")
+    for i, r in enumerate(throw_rotors):
+        if not 0 <= int(r) < n_rotors:
+            raise ParameterError(f"throw_rotors[{i}]", f"must be a rotor 1..{n_rotors}, got {int(r) + 1}")
+    P = np.zeros((n_rotors, len(cylinder_throws)))
+    for c, t in enumerate(cylinder_throws):
+        P[int(throw_rotors[t]), c] = 1.0
+    return P
+
+
+@dataclass
+class RotorExcitation:
+    """Harmonic torques on the rotors at any speed: ``F_q(omega) = G_q + omega^2 H_q``.
+
+    Attributes
+    ----------
+    orders : ndarray, shape (n_orders,)
+    gas : ndarray, shape (n_orders, n_rotors), complex
+        Speed-independent coefficients (N m), explicit harmonics included.
+    inertia_unit : ndarray, shape (n_orders, n_rotors), complex
+        Inertia coefficients at 1 rad/s (N m s^2).
+    cycle_revolutions : int
+    """
+
+    orders: np.ndarray
+    gas: np.ndarray
+    inertia_unit: np.ndarray
+    cycle_revolutions: int
+
+    def at(self, omega) -> np.ndarray:
+        """Coefficients at speeds ``omega`` (rad/s, shape (n_speeds,)): (n_speeds, n_orders, n_rotors)."""
+        w2 = np.asarray(omega, float)[:, None, None] ** 2
+        return self.gas[None] + w2 * self.inertia_unit[None]
+
+
+def rotor_excitation(n_rotors: int, max_order: float, cycle_revolutions: int,
+                     efforts: CylinderEfforts | None = None, throw_rotors=None,
+                     harmonics=()) -> RotorExcitation:
+    """Collect the machine's cylinder orders on their rotors, plus explicit harmonic torques.
+
+    Parameters
+    ----------
+    n_rotors : int
+    max_order : float
+        Highest order kept.
+    cycle_revolutions : int
+        1 or 2; orders are multiples of ``1 / cycle_revolutions``.
+    efforts : CylinderEfforts, optional
+    throw_rotors : sequence of int, optional
+        0-based rotor of each throw (required with ``efforts``).
+    harmonics : sequence of dict
+        ``{"rotor": 0-based, "order", "amplitude" (N m), "phase_deg"}``: ``T = A cos(q theta + phase)``.
+
+    Raises
+    ------
+    ParameterError
+        ``harmonics[i].order`` not a multiple of ``1 / cycle_revolutions`` or above ``max_order``,
+        ``harmonics[i].rotor`` out of range, ``throw_rotors`` wrong.
+    """
+    kmax = int(math.floor(max_order * cycle_revolutions + 1e-9))
+    if kmax < 1:
+        raise ParameterError("max_order", f"must be >= {1 / cycle_revolutions:g}, got {max_order}")
+    orders = np.arange(1, kmax + 1) / cycle_revolutions
+    gas = np.zeros((kmax, n_rotors), complex)
+    inertia = np.zeros((kmax, n_rotors), complex)
+    if efforts is not None:
+        if efforts.cycle_revolutions != cycle_revolutions:
+            raise ParameterError("cycle_revolutions", "differs from the machine's working cycle")
+        P = throw_to_rotor_matrix(efforts.cylinder_throws, throw_rotors, n_rotors)
+        g, h = efforts.cylinder_harmonics(max_order)
+        gas += g @ P.T
+        inertia += h @ P.T
+    for i, h in enumerate(harmonics):
+        k = h["order"] * cycle_revolutions
+        if abs(k - round(k)) > 1e-9 or not 1 <= round(k) <= kmax:
+            raise ParameterError(f"harmonics[{i}].order", f"must be a multiple of {1 / cycle_revolutions:g} "
+                                 f"in [{1 / cycle_revolutions:g}, {max_order:g}], got {h['order']:g}")
+        if not 0 <= h["rotor"] < n_rotors:
+            raise ParameterError(f"harmonics[{i}].rotor", f"must be 1..{n_rotors}, got {h['rotor'] + 1}")
+        gas[round(k) - 1, h["rotor"]] += h["amplitude"] * np.exp(1j * math.radians(h.get("phase_deg", 0.0)))
+    return RotorExcitation(orders=orders, gas=gas, inertia_unit=inertia,
+                           cycle_revolutions=cycle_revolutions)
