@@ -62,26 +62,38 @@ def run_ensemble(mech, base_stats: dict, n: int, t_end: float, dt: float, settin
     dict
         ``n_trajectories``, ``perturbation`` (relative), ``per_trajectory`` (one headline dict
         each, the base run first) and, per headline quantity, ``mean``, ``std``, ``min``,
-        ``max`` over the trajectories; ``wall_time_s``.
+        ``max`` over the trajectories; ``statistics_spread``: the same four for every statistic
+        of :func:`.stats.headline` (the names a tolerance study uses, so that it can state
+        convergence across the ensemble too); ``wall_time_s``.
     """
     from .analysis import simulate
+    from .stats import headline as stats_headline
     from .stats import statistics
 
     rows = [headline(base_stats)]
+    heads = [stats_headline(base_stats)]  # the tolerance study's statistics, for its verdict
     wall = 0.0
     for k in range(1, n):
         m = replace(mech, q0=np.asarray(mech.q0, float) * (1.0 + k * eps))
         h = simulate(m, t_end, dt, settings, energy_tolerance=energy_tolerance)
         wall += h.wall_time
-        rows.append(headline(statistics(h, revolution_hz, t_start, v_min)))
-    keys = [k for k in rows[0] if all(k in r for r in rows)]
-    spread = {}
-    for key in keys:
-        v = np.array([r[key] for r in rows], float)
-        spread[key] = {"mean": float(v.mean()), "std": float(v.std(ddof=1)),
-                       "min": float(v.min()), "max": float(v.max())}
+        st = statistics(h, revolution_hz, t_start, v_min)
+        rows.append(headline(st))
+        heads.append(stats_headline(st))
     return {"n_trajectories": n, "perturbation": eps, "per_trajectory": rows,
-            "spread": spread, "wall_time_s": wall}
+            "spread": _spread(rows), "statistics_spread": _spread([{k: v[0] for k, v in h.items()}
+                                                                  for h in heads]),
+            "wall_time_s": wall}
+
+
+def _spread(rows: list[dict]) -> dict:
+    """Mean, std (ddof 1), min and max over trajectories of each quantity all of them have."""
+    out = {}
+    for key in [k for k in rows[0] if all(k in r for r in rows)]:
+        v = np.array([r[key] for r in rows], float)
+        out[key] = {"mean": float(v.mean()), "std": float(v.std(ddof=1)),
+                    "min": float(v.min()), "max": float(v.max())}
+    return out
 
 
 __all__ = ["EPS", "headline", "run_ensemble"]

@@ -166,6 +166,11 @@ def rigid_twins(bodies: dict) -> dict:
     return out
 
 
+def flexible_key(body_name: str) -> str:
+    """The ``[dynamics.flexible]`` table of a flexible body (``rod_2`` -> ``rods``)."""
+    return "dynamics.flexible." + ("rods" if body_name.startswith("rod_") else body_name)
+
+
 def flexible_bodies_of(mech) -> list:
     """The mechanism's bodies with elastic coordinates."""
     return [b for b in mech.system.bodies if getattr(b, "n_elastic", 0) > 0]
@@ -244,8 +249,18 @@ def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict 
     return out
 
 
-def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
-    """The ``dynamics.flexible`` results block (see the module docstring)."""
+def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies, warnings=None) -> dict:
+    """The ``dynamics.flexible`` results block (see the module docstring).
+
+    Per body also ``validity`` (its elastic deflection against its size and its dynamic stress
+    against its material's yield strength, :func:`.validity.flexible_validity`; the warnings
+    go to ``warnings``, a list, as :func:`crankmodal.errors.warn` does) and
+    ``effective_damping`` (its lowest mode with its joints pinned, :mod:`.modal_damping`).
+    """
+    from ..errors import warn
+    from .modal_damping import effective_damping
+    from .validity import elastic_deflection, flexible_validity
+
     t = hist.t[sel]
     orders = list(range(13))
     res = {"bodies": {}, "files": bodies.get("files", {})}
@@ -268,6 +283,11 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
         stress = dynamic_stress(b, modal[sel], t, hist.crank_angle[sel])
         if stress is not None:
             d["dynamic_stress"] = stress
+        d["validity"], texts = flexible_validity(b, elastic_deflection(b, modal[sel], t),
+                                                 stress, flexible_key(b.name))
+        for text in texts:
+            warn(text, into=warnings)
+        d["effective_damping"] = effective_damping(b)
         res["bodies"][b.name] = d
     if rigid_hist is not None:
         cmp = {"main_bearing": force_comparison(t, hist.main_bearing_force[sel],
@@ -289,6 +309,6 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies) -> dict:
     return res
 
 
-__all__ = ["body_keys", "dynamic_stress", "flexible_results", "force_comparison",
+__all__ = ["body_keys", "dynamic_stress", "flexible_key", "flexible_results", "force_comparison",
            "interface_deflections", "link_length", "make_bodies", "make_links", "rigid_twins",
            "train_geometry", "truncation_warnings"]

@@ -171,8 +171,8 @@ def plot_energy(hist, path: Path) -> Path:
 
 def plot_study(study, path: Path) -> Path:
     """Error against wall time over the tolerance sequence: the single-trajectory peaks (left)
-    and the per-revolution statistics with their standard errors (right; filled markers:
-    converged, i.e. within two combined standard errors or 1 % of the tightest rtol)."""
+    and the per-revolution statistics (right; filled markers: converged, i.e. within the
+    study's ``rel_tol`` of the tightest rtol from there on: ``convergence_criterion``)."""
     plt = _plt()
     stats = study.get("statistics") or {}
     fig, axs = plt.subplots(1, 2 if stats else 1, figsize=(13 if stats else 7, 4.5),

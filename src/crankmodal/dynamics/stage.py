@@ -267,7 +267,8 @@ def run(params: dict, ctx) -> dict:
     if bodies is not None:
         from .flexstage import flexible_results
 
-        res["flexible"] = flexible_results(mech, hist, rigid, sel, rev_hz, bodies)
+        res["flexible"] = flexible_results(mech, hist, rigid, sel, rev_hz, bodies,
+                                           warnings=res["warnings"])
         res["flexible"]["rigid_integration_wall_time_s"] = None if rigid is None else rigid.wall_time
         res["flexible"]["start"] = {"state": p["flexible"]["start"], **(start_info or {})}
         from .flexstage import flexible_bodies_of
@@ -280,7 +281,8 @@ def run(params: dict, ctx) -> dict:
     study = None
     if p["solver"]["study_rtols"]:
         rt = sorted(set(p["solver"]["study_rtols"]) | {settings.rtol / 10})
-        study = tolerance_study(mech, t_end, dt, rt, t_start=float(hist.t[sel][0]), base=settings)
+        study = tolerance_study(mech, t_end, dt, rt, t_start=float(hist.t[sel][0]), base=settings,
+                                ensemble=res.get("ensemble"))
         res["tolerance_study"] = study
     arrays = hist.arrays()
     if rigid is not None:
@@ -316,7 +318,8 @@ def run(params: dict, ctx) -> dict:
         motion = f"rocker accel peak {res['angular_acceleration_peak'].get('rocker', 0.0):.4g} rad/s^2"
     if mech.system.clearances and res["statistics"]["window"]["n_revolutions"] >= 2:
         # a clearance run: one trajectory's peak is not a result, the per-revolution mean is
-        headline_text = converged_summary(res["statistics"], study, settings.rtol)
+        headline_text = converged_summary(res["statistics"], study, settings.rtol,
+                                          res.get("ensemble", {}).get("n_trajectories"))
     else:
         headline_text = f"main-bearing peak {res['main_bearing_force_peak_n']:.4g} N, {motion}"
     res["summary"] = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {t_end:g} s: {headline_text}, "
@@ -329,6 +332,9 @@ def run(params: dict, ctx) -> dict:
     if bodies is not None:
         names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in res["flexible"]["bodies"].items())
         res["summary"] += f"; flexible: {names}"
+        from .validity import validity_summary
+
+        res["summary"] += validity_summary(res["flexible"]["bodies"])
         cmp = res["flexible"].get("rigid", {}).get("main_bearing")
         if cmp:
             res["summary"] += (f"; main bearing flexible vs rigid: peak {cmp['peak_n']:.4g} vs "
@@ -344,7 +350,9 @@ def run(params: dict, ctx) -> dict:
 
 def _flexible_key(body_name: str) -> str:
     """The ``[dynamics.flexible]`` table of a flexible body (for advice)."""
-    return "dynamics.flexible." + ("rods" if body_name.startswith("rod_") else body_name)
+    from .flexstage import flexible_key
+
+    return flexible_key(body_name)
 
 
 def _figures(hist, ideal, mech, sel, study, out, spec=None):

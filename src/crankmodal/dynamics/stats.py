@@ -286,11 +286,13 @@ def _fmt(value: float, sem: float, unit: str) -> str:
     return f"{value / k:.4g} ± {sem / k:.2g} {'k' if k > 1 else ''}{unit}"
 
 
-def converged_summary(stats: dict, study: dict | None = None, rtol: float | None = None) -> str:
+def converged_summary(stats: dict, study: dict | None = None, rtol: float | None = None,
+                      n_trajectories: int | None = None) -> str:
     """The headline numbers of a clearance run for the summary line: per-revolution means with
-    their standard errors and, with a tolerance ``study``, whether each converged (its change
-    against the tightest rtol, at the run's own ``rtol`` if the study has it, else at the
-    second tightest) and how many statistics did."""
+    their standard errors and, with a tolerance ``study``, whether each converged (from the
+    run's own ``rtol`` if the study has it, else the second tightest, to the tightest, and
+    across an ensemble of ``n_trajectories`` if one ran: :func:`.analysis.statistics_convergence`),
+    how many statistics did and by how much the worst did not."""
     n = stats["window"]["n_revolutions"]
     conv = (study or {}).get("statistics", {})
     at = -2
@@ -299,15 +301,9 @@ def converged_summary(stats: dict, study: dict | None = None, rtol: float | None
         at = hit[0] if hit else -2
 
     def tag(name):
-        c = conv.get(name)
-        if not c or len(c["converged"]) < 2:
-            return ""
-        d = c["rel_change"][at]
-        if d is None or not c["converged"][at]:
-            return " (NOT converged" + ("" if d is None else f": {100 * d:.2g} %") + ")"
-        if d <= REL_TOL:
-            return f" (converged: {100 * d:.2g} %)"
-        return f" (converged within its standard error: {100 * d:.2g} %)"
+        from .analysis import convergence_tag
+
+        return convergence_tag(conv.get(name), at, study.get("rel_tol", REL_TOL)) if conv else ""
 
     mb = stats["main_bearing_force"]["per_rev_peak"]
     parts = [f"main-bearing per-rev peak {_fmt(mb['mean'], mb['sem'], 'N')}"
@@ -327,9 +323,7 @@ def converged_summary(stats: dict, study: dict | None = None, rtol: float | None
         parts.append(text)
     out = ", ".join(parts) + f" (mean ± standard error over {n} revs)"
     if conv and len(study["rtol"]) >= 2:
-        ok = [k for k, c in conv.items() if c["converged"][at]]
-        tight = [k for k in ok if (conv[k]["rel_change"][at] or 0.0) <= REL_TOL]
-        out += (f"; {len(ok)}/{len(conv)} per-rev statistics converged at rtol "
-                f"{study['rtol'][at]:g} against {study['rtol'][-1]:g} ({len(tight)} to 1 %, "
-                f"{len(ok) - len(tight)} only within 2 standard errors)")
+        from .analysis import convergence_line
+
+        out += "; " + convergence_line(study, at, n_trajectories)
     return out

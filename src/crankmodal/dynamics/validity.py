@@ -53,3 +53,221 @@ def penetration_warning(cj, depth: float, force: float, E: float = 2.1e11,
             f"{APPROACH_FACTOR:g} times): the contact law ({cj.law}) is far outside its "
             f"validity; raise dynamics.contact.stiffness (now {K:.3g}) or use "
             f"dynamics.contact.law = 'johnson_cylinder'")
+
+
+# ------------------------------------------------------------------ flexible bodies
+#: an elastic deflection above this fraction of the body's size gives a warning: the linear
+#: floating-frame model (small deformation about the undeformed shape, no geometric stiffening
+#: by the axial load, linear modes) no longer holds. At 2 % a pinned beam's end slope is about
+#: pi x 2 % = 0.06 rad and its chord shortens by ~0.1 % of the length (pi^2/4 (d/L)^2 L); both
+#: grow with the square of the deflection.
+DEFLECTION_FRACTION = 0.02
+
+
+def body_size(body) -> tuple[float, str]:
+    """The size a body's deflection is compared with, m, and what it is.
+
+    The largest in-plane distance between two of its interfaces (the span the joints hold),
+    or with fewer than two interfaces the in-plane diagonal of the mesh's bounding box."""
+    centres = [np.asarray(c, float)[:2] for c in body.info["interface_centres"].values()]
+    if len(centres) >= 2:
+        c = np.array(centres)
+        d = np.sqrt(((c[:, None, :] - c[None, :, :]) ** 2).sum(-1)).max()
+        if d > 0.0:
+            return float(d), "interface span"
+    fb = body.source
+    pts = None if fb is None else getattr(fb, "mesh_points", None)
+    if pts is not None:
+        p = np.asarray(pts, float)[:, :2]
+        return float(np.hypot(*(p.max(axis=0) - p.min(axis=0)))), "bounding-box diagonal"
+    return float("nan"), "unknown size"
+
+
+def interface_rigid_fit(body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The small rigid motion that best fits (least squares) the elastic displacements of the
+    body's interfaces, as linear maps of the elastic coordinates ξ (body axes).
+
+    Returns ``s_bar`` (2,), the interfaces' centroid (m, from the centre of mass), ``T`` (2, k),
+    the translation per ξ (m), and ``W`` (k,), the rotation per ξ (rad): the fitted rigid
+    displacement of a point ``p`` is ``(T + ẑ × (p − s_bar) W) ξ``. Needs two interfaces."""
+    k = body.n_elastic
+    names = list(body.info["interface_centres"])
+    s = np.array([body.frames[n][0] for n in names], float)          # (m, 2)
+    D = np.array([body.frames[n][1][:, :k] for n in names], float)   # (m, 2, k)
+    s_bar = s.mean(axis=0)
+    T = D.mean(axis=0)
+    r = s - s_bar
+    # rotation: sum of r x (u - T) over sum |r|^2 (the least-squares small rotation)
+    W = np.einsum("m,mk->k", r[:, 0], D[:, 1] - T[1]) - np.einsum("m,mk->k", r[:, 1],
+                                                                    D[:, 0] - T[0])
+    return s_bar, T, W / float(np.sum(r ** 2))
+
+
+def elastic_deflection(body, modal, t=None, chunk: int = 64) -> dict | None:
+    """Largest in-plane elastic deflection of a flexible body over a run, m.
+
+    With the mode shapes at the mesh nodes (a file with its mesh) and two interfaces or more,
+    the deflection is each node's elastic displacement less the small rigid motion that best
+    fits the interfaces' (least squares, :func:`interface_rigid_fit`): the bending the joints
+    see (a pinned-pinned beam's deflection from its chord). With one interface, the
+    displacement in the body's mean axes. Without mode shapes, the interfaces' displacements in
+    the mean axes (a lower bound). Returns None for a body without elastic modes.
+
+    Parameters
+    ----------
+    body : FlexibleBody
+    modal : (K, n_modes) array
+        Modal coordinates over the run (m kg^½).
+    t : (K,) array, optional
+        s, for ``time_s``.
+
+    Returns
+    -------
+    dict
+        ``max_m``, ``where`` (``mesh nodes, relative to the interfaces`` / ``mesh nodes, mean
+        axes`` / ``interfaces, mean axes``), ``location_m`` (part coordinates) and ``time_s``.
+    """
+    k = body.n_elastic
+    if k == 0:
+        return None
+    xi = np.asarray(modal, float)[:, :k]
+    fb = body.source
+    shapes = None if fb is None else getattr(fb, "mode_shapes", None)
+    pts = None if fb is None else getattr(fb, "mesh_points", None)
+    names = list(body.info["interface_centres"])
+    co, so = np.cos(-body.orientation), np.sin(-body.orientation)
+    R = np.array([[co, -so], [so, co]])                  # part x-y axes -> body axes
+    if shapes is None or pts is None:
+        best, where, loc, when = 0.0, "interfaces, mean axes", None, 0
+        for n in names:
+            u = xi @ body.frames[n][1][:, :k].T
+            a = np.hypot(u[:, 0], u[:, 1])
+            i = int(np.argmax(a))
+            if a[i] > best:
+                best, loc, when = float(a[i]), body.info["interface_centres"][n], i
+    else:
+        cols = np.asarray(body.info["mode_columns"], int)
+        B = np.einsum("ij,pjk->pik", R, np.asarray(shapes, float)[:, :2, cols])  # (P, 2, k)
+        if len(names) >= 2:
+            s_bar, T, W = interface_rigid_fit(body)
+            p = (np.asarray(pts, float)[:, :2] - body.centre) @ R.T - s_bar
+            B = B - T[None] - np.stack([-p[:, 1], p[:, 0]], axis=1)[:, :, None] * W
+            where = "mesh nodes, relative to the interfaces"
+        else:
+            where = "mesh nodes, mean axes"
+        best_p = np.zeros(B.shape[0])
+        when_p = np.zeros(B.shape[0], int)
+        for k0 in range(0, len(xi), chunk):
+            u = np.einsum("pik,tk->tpi", B, xi[k0:k0 + chunk])
+            a = np.hypot(u[..., 0], u[..., 1])
+            i = np.argmax(a, axis=0)
+            v = a[i, np.arange(a.shape[1])]
+            better = v > best_p
+            best_p[better], when_p[better] = v[better], k0 + i[better]
+        j = int(np.argmax(best_p))
+        best, when, loc = float(best_p[j]), int(when_p[j]), np.asarray(pts)[j].tolist()
+    return {"max_m": best, "where": where, "location_m": loc,
+            "time_s": None if t is None else float(t[when])}
+
+
+def yield_strength(body) -> tuple[float | None, str | None]:
+    """The yield strength (Pa) of the body's material and the material's name, from the
+    flexbody file's provenance (``info["material"]``, a name of the material library);
+    ``(None, name or None)`` when the file names no material or the library has no yield for it."""
+    fb = body.source
+    name = None if fb is None else (getattr(fb, "info", None) or {}).get("material")
+    if not name:
+        return None, None
+    from ..errors import ParameterError
+    from ..fem.materials import material
+
+    try:
+        return material(str(name)).yield_strength, str(name)
+    except ParameterError:
+        return None, str(name)
+
+
+def flexible_validity(body, deflection: dict | None, stress: dict | None, key: str,
+                      fraction: float = DEFLECTION_FRACTION) -> tuple[dict, list[str]]:
+    """Whether a flexible body stayed inside the linear floating-frame model: its elastic
+    deflection against ``fraction`` of its size (:func:`body_size`) and its dynamic stress
+    (von Mises, from the stress modes) against its material's yield strength.
+
+    Parameters
+    ----------
+    body : FlexibleBody
+    deflection : dict or None
+        :func:`elastic_deflection`.
+    stress : dict or None
+        :func:`.flexstage.dynamic_stress` (``max_von_mises_pa``), None without stress modes.
+    key : str
+        The body's scene table (``dynamics.flexible.coupler``), named in the warnings.
+
+    Returns
+    -------
+    block : dict
+        ``size_m``, ``size_of``, ``deflection_max_m``, ``deflection_fraction``,
+        ``deflection_limit_fraction``, ``deflection_where``, ``max_von_mises_pa``,
+        ``material``, ``yield_strength_pa``, ``stress_checked`` and ``inside`` (bool).
+    warnings : list of str
+    """
+    size, size_of = body_size(body)
+    d = None if deflection is None else deflection["max_m"]
+    frac = d / size if (d is not None and size > 0) else None
+    sy, mat = yield_strength(body)
+    sv = None if stress is None else stress["max_von_mises_pa"]
+    block = {"size_m": size, "size_of": size_of, "deflection_max_m": d,
+             "deflection_fraction": frac, "deflection_limit_fraction": fraction,
+             "deflection_where": None if deflection is None else deflection["where"],
+             "deflection_time_s": None if deflection is None else deflection["time_s"],
+             "max_von_mises_pa": sv, "material": mat, "yield_strength_pa": sy,
+             "stress_checked": sv is not None and sy is not None}
+    out = []
+    name = body.name
+    if frac is not None and frac > fraction:
+        out.append(f"{key}: {name} deflects {1e3 * d:.3g} mm elastically ({deflection['where']}),"
+                   f" {100 * frac:.3g} % of its {1e3 * size:.3g} mm {size_of} (warning above "
+                   f"{100 * fraction:g} %): the linear floating-frame model (small deformation, "
+                   f"no geometric stiffening) no longer holds and its forces, deflections and "
+                   f"stresses are outside the model's validity")
+    if sv is not None and sy is not None and sv > sy:
+        out.append(f"{key}: {name}'s dynamic stress reaches {sv / 1e6:.4g} MPa (von Mises, "
+                   f"from its stress modes), {sv / sy:.3g} times the yield strength "
+                   f"{sy / 1e6:.4g} MPa of {mat}: a linear-elastic body would have yielded, the "
+                   f"model does not hold")
+    elif sv is not None and sy is None:
+        why = (f"the material library has no yield strength for {mat!r}" if mat
+               else "its file names no material")
+        out.append(f"{key}: {name}'s dynamic stress ({sv / 1e6:.4g} MPa von Mises) is not "
+                   f"checked against a yield strength: {why}")
+    block["inside"] = not any(w for w in out if "not checked" not in w)
+    return block, out
+
+
+def validity_summary(bodies: dict) -> str:
+    """The summary's words on flexible bodies: each one's lowest mode with its joints pinned
+    and its effective damping, and the bodies outside the model's validity.
+
+    ``bodies``: results ``dynamics.flexible.bodies`` (``validity``, ``effective_damping``)."""
+    parts, bad = [], []
+    for name, d in bodies.items():
+        e = d.get("effective_damping")
+        if e:
+            parts.append(f"{name} {e['frequency_hz']:.4g} Hz with its joints pinned, effective "
+                         f"damping {e['damping_ratio']:.2g} ({e['given_ratio']:g} given on its "
+                         f"free-free modes)")
+        v = d.get("validity") or {}
+        why = []
+        if v.get("deflection_fraction") is not None and \
+                v["deflection_fraction"] > v["deflection_limit_fraction"]:
+            why.append(f"deflects {100 * v['deflection_fraction']:.3g} % of its {v['size_of']}")
+        if v.get("stress_checked") and v["max_von_mises_pa"] > v["yield_strength_pa"]:
+            why.append(f"stress {v['max_von_mises_pa'] / 1e6:.4g} MPa > yield "
+                       f"{v['yield_strength_pa'] / 1e6:.4g} MPa")
+        if why:
+            bad.append(f"{name} " + " and ".join(why))
+    out = "; lowest modes: " + ", ".join(parts) if parts else ""
+    if bad:
+        out += ("; OUTSIDE THE LINEAR FLEXIBLE MODEL'S VALIDITY: " + "; ".join(bad)
+                + " (results warnings)")
+    return out
