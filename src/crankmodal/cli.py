@@ -82,6 +82,11 @@ def _parser() -> argparse.ArgumentParser:
     sw.add_argument("--retry-failed", action="store_true",
                     help="run again the recorded points that failed")
     sw.add_argument("--no-figures", action="store_true", help="skip the sweep_<output>.png maps")
+    sw.add_argument("--max-failed", type=float, metavar="SHARE",
+                    help="share of failed points (0-1) above which the sweep exits with status 4 "
+                         "(default: the sweep file's max_failed, else 0.1)")
+    sw.add_argument("--dry-run", action="store_true",
+                    help="check every point and count those recorded and to run; run nothing")
 
     sub.add_parser("machines", parents=[debug], help="list the machine parameter files")
     return p
@@ -117,9 +122,31 @@ def _sweep(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise CrankmodalError(f"--workers: must be >= 1, got {args.workers}")
     out_dir = args.out if args.out is not None else Path("out") / (args.sweep.stem + "_sweep")
-    res = run_sweep(args.sweep, out_dir, scheduler=args.scheduler, workers=args.workers,
-                    retry_failed=args.retry_failed, figures=not args.no_figures,
-                    log=lambda m: print(m, file=sys.stderr))
+    if args.max_failed is not None:
+        from .sweep.spec import check_max_failed
+
+        check_max_failed("--max-failed", args.max_failed)
+    if args.dry_run:
+        from .sweep.driver import plan_sweep
+
+        plan = plan_sweep(args.sweep, out_dir)
+        print(f"sweep {plan['name']}: {plan['n_points']} points checked, {plan['recorded']} "
+              f"recorded in {out_dir}, {plan['to_run']} to run"
+              + (" (and the search's rounds)" if plan["search"] else "")
+              + (f"; {plan['bad_record_lines']} bad record line(s) would be skipped"
+                 if plan["bad_record_lines"] else "") + "; nothing run (--dry-run)")
+        return 0
+    from .sweep.driver import FAILED_EXIT, SweepInterrupted
+
+    try:
+        res = run_sweep(args.sweep, out_dir, scheduler=args.scheduler, workers=args.workers,
+                        retry_failed=args.retry_failed, figures=not args.no_figures,
+                        max_failed=args.max_failed, log=lambda m: print(m, file=sys.stderr))
+    except SweepInterrupted as exc:
+        how = "terminated" if isinstance(exc.original, _Terminated) else "interrupted"
+        print(f"crankmodal: {how}: {exc.recorded} of {exc.total} points recorded; resume with: "
+              f"crankmodal sweep {args.sweep} --out {out_dir}", file=sys.stderr)
+        return 143 if how == "terminated" else 130
     print(f"sweep {res['name']}: {res['n_points']} points, {res['n_ok']} ok, "
           f"{res['n_failed']} failed ({res['ran']} run now, {res['skipped']} already recorded) "
           f"in {res['wall_time_s']:.1f} s")
@@ -128,7 +155,8 @@ def _sweep(args) -> int:
         print(f"search: {s['sense']} {s['objective']} = {s['best_value']!r} at "
               f"{s['best_parameters']} (point {s['best_point']})")
     print(f"sweep: {out_dir / 'sweep.json'}")
-    return 0
+    print(res["failures"]["line"], file=sys.stderr if res["failures"]["exceeded"] else sys.stdout)
+    return FAILED_EXIT if res["failures"]["exceeded"] else 0
 
 
 #: command -> (the summary file it writes, suffix of its default folder ``out/<scene name>``)

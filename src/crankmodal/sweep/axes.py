@@ -57,13 +57,48 @@ def _number(key: str, name: str, v) -> float:
     return v
 
 
+#: Decimal digits kept below the leading digit of an axis's step (:func:`tidy`).
+STEP_DIGITS = 9
+
+
+def tidy(value: float, step: float) -> float:
+    """``value`` rounded to :data:`STEP_DIGITS` decimal digits below the leading digit of
+    ``step``, the resolution of the axis it lies on.
+
+    ``start + i * step`` in binary floating point carries noise of about 1e-16 of the value
+    (``np.linspace(0, 0.4, 17)[3]`` is 0.07500000000000001); the noise reached the point's
+    ``--set`` value, its key and the CSV. Rounding far below the step removes it (0.075) and
+    keeps every digit the grid has, for values up to ~1e6 steps from zero.
+
+    Parameters
+    ----------
+    value : float
+        A grid value, in the axis's unit.
+    step : float
+        The spacing of the grid around it (> 0), same unit; for a geometric axis the local
+        spacing ``value * (ratio - 1)``.
+    """
+    if not (step > 0 and math.isfinite(step) and math.isfinite(value)):
+        return value
+    return round(value, STEP_DIGITS - math.floor(math.log10(step)))
+
+
+def grid_step(value: float, step: float, log: bool) -> float:
+    """The spacing around ``value`` of a grid of ``step`` (a log step for a geometric grid)."""
+    return abs(value) * math.expm1(step) if log else step
+
+
 def range_values(start: float, stop: float, num: int, log: bool = False,
                  integer: bool = False) -> tuple:
-    """``num`` values from ``start`` to ``stop`` (both included), evenly or geometrically."""
+    """``num`` values from ``start`` to ``stop`` (both included), evenly or geometrically,
+    each :func:`tidy` (0.075, not 0.07500000000000001)."""
     vals = np.geomspace(start, stop, num) if log else np.linspace(start, stop, num)
     if integer:
         return tuple(round(float(v)) for v in vals)
-    return tuple(float(v) for v in vals)
+    if num < 2:
+        return tuple(float(v) for v in vals)
+    step = abs(math.log(stop / start) if log else stop - start) / (num - 1)
+    return tuple(tidy(float(v), grid_step(float(v), step, log)) for v in vals)
 
 
 def parse_axis(key: str, spec) -> Axis:

@@ -6,19 +6,26 @@ one thread so PARDISO and BLAS do not oversubscribe the cores), or any cluster t
 scheduler address or a :class:`~dask.distributed.Client`. The driver keeps a bounded number of
 points in flight (twice the workers' threads), so a sweep of thousands of points keeps the
 client's memory flat; records go to disk as they arrive.
+
+Ctrl-C (or SIGTERM) is the client's alone: the local cluster's worker processes are started
+with SIGINT ignored (a terminal sends it to the whole process group, and each worker would print
+its own traceback), so the driver cancels the points in flight, closes the cluster and raises
+:class:`SweepInterrupted` saying how far the sweep got.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import signal
+import threading
 import time
 from pathlib import Path
 
 from ..errors import CrankmodalError
 from ..results import make_out_dir, write_json_atomic
 from .execute import build_scene, execute_point, overrides_of, point_key
-from .spec import SweepSpec, load_sweep
+from .spec import SweepSpec, check_max_failed, load_sweep
 from .store import RecordStore, folder_lock
 from .table import missing_outputs, refresh_outputs, suggestion, summarise, write_csv
 
@@ -36,8 +43,67 @@ WORKER_CONFIG = {"distributed.admin.tick.interval": "1s",
 CONNECT_TIMEOUT_S = 3
 
 
+#: Exit status of ``crankmodal sweep`` when more than ``max_failed`` of the points failed: the
+#: table and summary are written (unlike exit 2, bad input, where nothing is), but a script
+#: must not take them for a complete sweep.
+FAILED_EXIT = 4
+
+
 class SchedulerError(CrankmodalError):
     """The Dask scheduler given by address cannot be reached."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or SIGTERM) stopped a sweep; raised once its cluster is closed.
+
+    Attributes
+    ----------
+    recorded, total : int
+        Points of the sweep with a record (kept: a re-run skips them) and points planned.
+    out_dir : Path
+        The sweep's folder.
+    original : KeyboardInterrupt
+        The interrupt as raised (the CLI's SIGTERM is a subclass).
+    """
+
+    def __init__(self, recorded: int, total: int, out_dir: Path, original: BaseException):
+        self.recorded, self.total, self.out_dir, self.original = recorded, total, out_dir, original
+        super().__init__(f"{recorded} of {total} points recorded")
+
+
+@contextlib.contextmanager
+def _children_ignore_sigint():
+    """Processes started inside the block ignore SIGINT: an ignored signal stays ignored through
+    fork and exec (Python and asyncio then install no handler of their own), so Dask's worker
+    processes never see the terminal's Ctrl-C and the client shuts them down. The price: a
+    Ctrl-C in the second or two the local cluster takes to start is ignored here too (blocking
+    it instead would not do: the BLAS threads that exist already would take and drop it)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, handler)
+
+
+def _ignore_sigint() -> None:
+    """A second Ctrl-C while the cluster shuts down would break the shutdown halfway."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
+def _sigint_handler_kept():
+    """Restore the SIGINT handler on leaving (after :func:`_ignore_sigint`)."""
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.getsignal(signal.SIGINT) if main else None
+    try:
+        yield
+    finally:
+        if main and previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
 def plan_tasks(spec: SweepSpec, points: list[dict], out_dir: Path, first_index: int = 0,
@@ -57,6 +123,9 @@ def plan_tasks(spec: SweepSpec, points: list[dict], out_dir: Path, first_index: 
         try:
             check(build_scene(spec.base_text, str(spec.base), ov))
         except CrankmodalError as exc:
+            absent = _absent_sections(spec)
+            if absent:  # the override made the section up: that, not its value, is the problem
+                raise type(exc)(absent[0]) from None
             where = ", ".join(f"{k}={v!r}" for k, v in p.items())
             raise type(exc)(f"point {i} ({where}): {exc}") from None
         key = point_key(spec.base_digest, ov)
@@ -65,6 +134,28 @@ def plan_tasks(spec: SweepSpec, points: list[dict], out_dir: Path, first_index: 
                       "dir": str(out_dir / "points" / key), "outputs": spec.outputs,
                       "timeout_s": spec.timeout_s, "figures": spec.figures, "round": round_no})
     return tasks
+
+
+def _absent_sections(spec: SweepSpec) -> list[str]:
+    """One message per axis or ``set`` key whose section the base scene lacks. An override
+    does not add a section's other keys (nor its machine's defaults), so such a point fails its
+    check on whatever the lone key makes of the section; this names the actual cause."""
+    try:
+        scene = build_scene(spec.base_text, str(spec.base), [])
+    except CrankmodalError:
+        return []  # the base scene's own error is the one to show
+    have = set(scene.sections)
+    out = []
+    for where, key in [*((f"axes.{a.key}", a.key) for a in spec.axes),
+                       *((f"set: {s.partition('=')[0].strip()}", s.partition("=")[0].strip())
+                         for s in spec.fixed)]:
+        section = key.split(".")[0]
+        if section not in have:
+            out.append(f"{where}: the base scene {spec.base.name} has no [{section}] section "
+                       f"(it has {', '.join(f'[{s}]' for s in scene.sections) or 'none'}); a "
+                       f"sweep only varies keys of its base scene: add [{section}] to it or "
+                       f"take a base scene that has one")
+    return out
 
 
 def check_output_sections(spec: SweepSpec, task: dict) -> None:
@@ -113,14 +204,18 @@ def dask_client(client=None, scheduler: str | None = None, workers: int | None =
         dashboard = None
     import dask
 
-    with dask.config.set(WORKER_CONFIG):  # each Nanny hands its config to its worker process
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=THREAD_ENV,
-                               dashboard_address=dashboard, silence_logs=logging.ERROR)
+    cluster = None
     try:
+        # each Nanny hands its config to its worker process; the workers ignore SIGINT
+        with dask.config.set(WORKER_CONFIG), _children_ignore_sigint():
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   env=THREAD_ENV, dashboard_address=dashboard,
+                                   silence_logs=logging.ERROR)
         with Client(cluster) as c:
             yield c
     finally:
-        cluster.close()
+        if cluster is not None:
+            cluster.close()
 
 
 class LazyClient:
@@ -159,8 +254,8 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
     """
     from ..progress import bar
 
-    todo = [t for t in tasks if t["key"] not in done]
-    skipped = len(tasks) - len(todo)
+    todo = list({t["key"]: t for t in tasks if t["key"] not in done}.values())  # a key once
+    skipped = sum(t["key"] in done for t in tasks)
     if not todo:
         return {"ran": 0, "skipped": skipped, "failed": 0}
     if isinstance(client, LazyClient):
@@ -223,7 +318,8 @@ def run_tasks_in_process(tasks: list[dict], store: RecordStore, done: dict, log=
     from ..progress import bar
     from .execute import execute_point
 
-    todo = [t for t in tasks if t["key"] not in done]
+    todo = list({t["key"]: t for t in tasks if t["key"] not in done}.values())  # a key once
+    skipped = sum(t["key"] in done for t in tasks)
     failed = 0
     with bar(total=len(todo), desc="models", unit="pt") as pb:
         for task in todo:
@@ -237,12 +333,12 @@ def run_tasks_in_process(tasks: list[dict], store: RecordStore, done: dict, log=
                 pb.clear()
                 log(f"point {rec['point']}: {rec['status']}: {rec['error']}")
                 pb.refresh()
-    return {"ran": len(todo), "skipped": len(tasks) - len(todo), "failed": failed}
+    return {"ran": len(todo), "skipped": skipped, "failed": failed}
 
 
 def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
               workers: int | None = None, retry_failed: bool = False, figures: bool = True,
-              log=None) -> dict:
+              max_failed: float | None = None, log=None) -> dict:
     """Run a sweep (and its search) and write its records, table and ``sweep.json``.
 
     Parameters
@@ -262,13 +358,20 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
         Run again the recorded points that failed (error, timeout).
     figures : bool
         Write ``sweep_<output>.png`` maps (:mod:`crankmodal.sweep.figures`).
+    max_failed : float, optional
+        Share of the points (0 to 1) that may fail (error, timeout) before the sweep counts as
+        failed (``failures.exceeded`` in the result; the CLI then exits with
+        :data:`FAILED_EXIT`). Default: the sweep file's ``max_failed`` (itself
+        :data:`.spec.MAX_FAILED`, 0.1, when absent).
     log : callable, optional
-        ``log(str)`` for progress lines.
+        ``log(str)`` for progress lines, the skipped bad record lines and the failures line.
+        Without it, bad record lines are a :class:`UserWarning`.
 
     Returns
     -------
     dict
-        What ``sweep.json`` holds.
+        What ``sweep.json`` holds; ``failures`` (``n``, ``share``, ``max_failed``,
+        ``exceeded``, ``line``) says how many points failed and where their errors are.
 
     Raises
     ------
@@ -276,38 +379,104 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
         Bad sweep or point (before anything runs), unreachable scheduler (SchedulerError), an
         output no successful point produced (after the run; the records are kept, so fixing
         ``outputs`` and re-running recomputes nothing).
+    SweepInterrupted
+        Ctrl-C or SIGTERM: the cluster is closed, the finished points' records are kept.
     """
     t0 = time.perf_counter()
     spec = spec if isinstance(spec, SweepSpec) else load_sweep(spec)
+    share = spec.max_failed if max_failed is None else check_max_failed("max_failed", max_failed)
     out_dir = Path(out_dir)
     tasks = plan_tasks(spec, spec.points(), out_dir.resolve())  # every point checked first
     check_output_sections(spec, tasks[0])
     out_dir = make_out_dir(out_dir)
     with folder_lock(out_dir):
         return _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed,
-                           figures, log, t0)
+                           figures, share, log, t0)
 
 
-def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, figures, log,
-                t0) -> dict:
+def plan_sweep(spec, out_dir) -> dict:
+    """Check a sweep and count what a run would do, running nothing (``--dry-run``).
+
+    Every point's scene is checked as :func:`run_sweep` does; nothing is written.
+
+    Returns
+    -------
+    dict
+        ``n_points`` (of the grid or samples; a search adds its rounds' points when run),
+        ``recorded`` (of those, recorded in ``out_dir/records.jsonl``: a run skips them),
+        ``to_run``, ``bad_record_lines`` (lines of the records file a run would skip).
+    """
+    spec = spec if isinstance(spec, SweepSpec) else load_sweep(spec)
+    out_dir = Path(out_dir)
+    tasks = plan_tasks(spec, spec.points(), out_dir.resolve())
+    check_output_sections(spec, tasks[0])
+    store = RecordStore(out_dir / "records.jsonl")
+    done = store.read()
+    keys = dict.fromkeys(t["key"] for t in tasks)
+    recorded = sum(k in done for k in keys)
+    return {"name": spec.name, "n_points": len(keys), "recorded": recorded,
+            "to_run": len(keys) - recorded, "bad_record_lines": len(store.skipped),
+            "search": bool(spec.search)}
+
+
+def failures(records: list[dict], max_failed: float, out_dir: Path) -> dict:
+    """How many points failed, whether that is more than ``max_failed`` of them, and the one
+    line that says so and where their errors are."""
+    bad = [r for r in records if r["status"] != "ok"]
+    n = len(records)
+    share = len(bad) / n if n else 0.0
+    exceeded = share > max_failed
+    line = f"failed: {len(bad)} of {n} points ({100 * share:.3g} %"
+    line += (f", more than max_failed = {100 * max_failed:.3g} %)" if exceeded else
+             f"; max_failed = {100 * max_failed:.3g} %)")
+    if bad:
+        first = bad[0]
+        line += (f"; errors: {out_dir / 'sweep.csv'} (column error) and "
+                 f"{out_dir / 'records.jsonl'}; first: point {first['point']}: {first['status']}: "
+                 f"{first['error']}")
+    return {"n": len(bad), "share": share, "max_failed": max_failed, "exceeded": exceeded,
+            "line": line}
+
+
+def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, figures,
+                max_failed, log, t0) -> dict:
     """:func:`run_sweep` once the folder is made and locked."""
     for stale in ("sweep.json", "sweep.csv", *(p.name for p in out_dir.glob("sweep_*.png"))):
         # a failed re-run must not leave an old table or map looking like its answer
         (out_dir / stale).unlink(missing_ok=True)
     store = RecordStore(out_dir.resolve() / "records.jsonl")  # point dirs are absolute
     done = store.read()
+    if store.skipped:
+        if log:
+            log(f"warning: {store.skipped_line()}")
+        else:
+            import warnings
+
+            warnings.warn(store.skipped_line(), UserWarning, stacklevel=3)
     if retry_failed:
         done = {k: r for k, r in done.items() if r.get("status") == "ok"}
+    before = set(done)  # recorded by earlier runs: "already recorded", not "run now"
     stats = {"ran": 0, "skipped": 0, "failed": 0}
     rounds = []
     keys = [t["key"] for t in tasks]
-    with contextlib.ExitStack() as stack:
-        lazy = LazyClient(stack, client, scheduler, workers, log)
-        _add(stats, run_tasks(lazy, tasks, store, done, log))
-        if spec.search:
-            rounds, more = _search(spec, lazy, tasks, store, done, out_dir.resolve(), log, stats)
-            keys += more
-        info = lazy.info
+    try:
+        with contextlib.ExitStack() as stack:
+            stack.enter_context(_sigint_handler_kept())  # restored after the cluster closed
+            lazy = LazyClient(stack, client, scheduler, workers, log)
+            try:
+                _add(stats, run_tasks(lazy, tasks, store, done, log))
+                if spec.search:
+                    rounds, more = _search(spec, lazy, tasks, store, done, out_dir.resolve(),
+                                           log, stats)
+                    keys += more
+            except KeyboardInterrupt:
+                _ignore_sigint()  # until the cluster is closed (the stack's unwinding)
+                raise
+            info = lazy.info
+    except KeyboardInterrupt as exc:
+        planned = dict.fromkeys(keys)
+        raise SweepInterrupted(sum(k in done for k in planned), len(planned), out_dir,
+                               exc) from None
     records = [refresh_outputs(done[k], spec.outputs, out_dir) for k in dict.fromkeys(keys)]
     records.sort(key=lambda r: (r.get("round", 0), r["point"]))
     missing = missing_outputs(records, spec.outputs)
@@ -319,6 +488,7 @@ def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, 
             "are kept and not recomputed)")
     axis_keys = [a.key for a in spec.axes]
     write_csv(out_dir / "sweep.csv", records, axis_keys, spec.outputs)
+    fails = failures(records, max_failed, out_dir)
     by_status: dict = {}
     for r in records:
         by_status[r["status"]] = by_status.get(r["status"], 0) + 1
@@ -329,7 +499,8 @@ def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, 
         "set": spec.fixed, "outputs": spec.outputs, "timeout_s": spec.timeout_s,
         "n_points": len(records), "status_counts": by_status,
         "n_ok": by_status.get("ok", 0), "n_failed": len(records) - by_status.get("ok", 0),
-        "ran": stats["ran"], "skipped": stats["skipped"],
+        "ran": stats["ran"], "skipped": sum(k in before for k in dict.fromkeys(keys)),
+        "failures": fails,
         "wall_time_s": time.perf_counter() - t0, "dask": info,
         "files": {"records": "records.jsonl", "table": "sweep.csv", "points": "points/"},
         "output_ranges": summarise(records, spec.outputs),

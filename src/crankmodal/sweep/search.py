@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from .axes import Axis
+from .axes import Axis, grid_step, tidy
 
 
 def objective_value(record: dict, objective: str):
@@ -70,9 +70,10 @@ def refine(axes: list[Axis], centre: dict, steps: dict[str, float], num: int):
         else:
             v = np.linspace(c - h, c + h, num)
         v = np.clip(v, lo, hi)
-        v = [round(float(x)) for x in v] if a.integer else [float(x) for x in v]
-        values.append(list(dict.fromkeys(v)))  # clipped duplicates once
         new_steps[a.key] = 2 * h / (num - 1)
+        v = [round(float(x)) for x in v] if a.integer else \
+            [tidy(float(x), grid_step(float(x), new_steps[a.key], a.log)) for x in v]
+        values.append(list(dict.fromkeys(v)))  # clipped duplicates once
     keys = [a.key for a in axes]
     return [dict(zip(keys, combo, strict=True)) for combo in itertools.product(*values)], new_steps
 

@@ -9,6 +9,7 @@
     set = ["mechanism.n_points=360"]    # fixed overrides of every point
     outputs = ["mechanism.first_order_force_max_n"]
     timeout_s = 600                     # per point; a point over it is recorded as "timeout"
+    max_failed = 0.1                    # share of failed points above which the sweep failed
     figures = false                     # the points' own PNGs
 
     [axes]
@@ -35,10 +36,13 @@ from ..errors import InputFileError, SceneError
 from ..resources import decode_utf8, load_toml
 from .axes import MODES, Axis, flatten_axes, generate, parse_axis
 
-KEYS = ("base", "mode", "samples", "seed", "set", "outputs", "timeout_s", "figures", "axes",
-        "search", "name", "description")
+KEYS = ("base", "mode", "samples", "seed", "set", "outputs", "timeout_s", "max_failed",
+        "figures", "axes", "search", "name", "description")
 SEARCH_KEYS = ("maximize", "minimize", "method", "rounds", "num", "max_points", "xtol")
 SEARCH_METHODS = ("grid", "powell", "nelder-mead")
+#: Default share of a sweep's points that may fail (error, timeout) before the sweep counts as
+#: failed: ``crankmodal sweep`` then exits with status 4 (:data:`.driver.FAILED_EXIT`).
+MAX_FAILED = 0.1
 
 
 @dataclass
@@ -62,6 +66,9 @@ class SweepSpec:
         Of random / lhs sweeps.
     timeout_s : float or None
         Wall-time limit of one point, s.
+    max_failed : float
+        Share of the points (0 to 1) that may fail before the sweep counts as failed (the CLI
+        exits with status 4).
     figures : bool
         Let each point write its PNGs.
     search : dict or None
@@ -78,6 +85,7 @@ class SweepSpec:
     samples: int | None = None
     seed: int = 0
     timeout_s: float | None = None
+    max_failed: float = MAX_FAILED
     figures: bool = False
     search: dict | None = None
     name: str = "sweep"
@@ -89,6 +97,15 @@ class SweepSpec:
     @property
     def base_digest(self) -> str:
         return hashlib.sha256(self.base_text.encode()).hexdigest()
+
+
+def check_max_failed(name: str, value) -> float:
+    """``value`` as a share of the points in [0, 1]; a :class:`SceneError` naming ``name``
+    (the sweep key, the ``--max-failed`` option or the API argument) otherwise."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value <= 1:
+        raise SceneError(f"{name}: must be a share of the points from 0 to 1 (0.1 = 10 %), "
+                         f"got {value!r}")
+    return float(value)
 
 
 def _typed(key, value, kinds, what):
@@ -185,6 +202,7 @@ def parse_sweep(data: dict, base_dir: Path | str = ".", name: str = "sweep") -> 
         if not (math.isfinite(timeout) and timeout > 0):
             raise SceneError(f"timeout_s: must be > 0, got {timeout!r}")
     figures = _typed("figures", data.get("figures", False), (bool,), "true or false")
+    max_failed = check_max_failed("max_failed", data.get("max_failed", MAX_FAILED))
     search = parse_search(data["search"], axes, mode) if "search" in data else None
     if search and search["objective"] not in outputs:
         outputs = [*outputs, search["objective"]]
@@ -192,7 +210,8 @@ def parse_sweep(data: dict, base_dir: Path | str = ".", name: str = "sweep") -> 
         raise SceneError(f"samples: mode = {mode!r} needs samples = <number of points>")
     return SweepSpec(base=base, base_text=base_text, axes=axes, mode=mode, outputs=list(outputs),
                      fixed=list(fixed), samples=samples, seed=seed,
-                     timeout_s=None if timeout is None else float(timeout), figures=figures,
+                     timeout_s=None if timeout is None else float(timeout),
+                     max_failed=float(max_failed), figures=figures,
                      search=search, name=_typed("name", data.get("name", name), (str,), "a string"))
 
 
