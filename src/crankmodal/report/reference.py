@@ -34,7 +34,7 @@ def _real(path: Path, name: str, value) -> np.ndarray:
     if a.dtype.kind not in "iuf":
         _fail(path, f"member '{name}' must hold real numbers, got dtype {a.dtype}")
     a = a.astype(float)
-    bad = np.count_nonzero(~np.isfinite(a))
+    bad = int(np.count_nonzero(~np.isfinite(a)))
     if bad:
         _fail(path, f"member '{name}' has {bad} NaN or infinite value{'s' * (bad > 1)} "
                     f"(of {a.size}); a reference must be finite everywhere")
