@@ -124,10 +124,12 @@ class History:
             out[f"modal_{name}"] = v
         return out
 
-    def peak(self, key: str, sampled, name: str | None = None, since: float | None = None):
+    def peak(self, key: str, sampled, name: str | None = None, since: float | None = None,
+             until: float | None = None):
         """Largest magnitude of a sampled quantity and of its values at the contacts' deepest
-        points (``key`` of :attr:`peaks`; every joint's, or joint ``name``'s; from time
-        ``since`` on, s, if given — the samples are the caller's to select).
+        points (``key`` of :attr:`peaks`; every joint's, or joint ``name``'s; the events from
+        time ``since`` on and up to ``until``, s, if given — the samples are the caller's to
+        select).
 
         ``sampled`` of shape (K,) gives a float; of shape (K, P), one peak per column.
         """
@@ -135,7 +137,12 @@ class History:
         parts = [sampled]
         for j, pk in self.peaks.items():
             if name is None or j == name:
-                keep = slice(None) if since is None else pk["t"] >= since
+                tk = np.asarray(pk["t"], float)
+                keep = np.ones(tk.size, bool)
+                if since is not None:
+                    keep &= tk >= since
+                if until is not None:
+                    keep &= tk <= until
                 parts.append(np.abs(pk[key]).reshape((len(pk["t"]),) + sampled.shape[1:])[keep])
         out = np.max(np.concatenate(parts), axis=0, initial=0.0)
         return float(out) if out.ndim == 0 else out

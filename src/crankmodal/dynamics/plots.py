@@ -21,6 +21,15 @@ def _save(plt, fig, path: Path) -> Path:
     return path
 
 
+def mark_window(ax, window, label: bool = True) -> None:
+    """Shade the results (statistics) window ``(start, end)`` in s on a time axis; None: no
+    window."""
+    if window is None:
+        return
+    ax.axvspan(window[0], window[1], color="0.85", alpha=0.5, lw=0, zorder=0,
+               label="statistics window" if label else None)
+
+
 def last_revolutions(hist, n: float) -> np.ndarray:
     """Boolean mask of the output times within the last ``n`` crank revolutions (by the crank
     angle turned, either sense; the whole run when it is shorter)."""
@@ -30,11 +39,13 @@ def last_revolutions(hist, n: float) -> np.ndarray:
     return np.abs(a[-1] - a) <= 2.0 * np.pi * n
 
 
-def plot_piston(hist, ideal, path: Path, piston: int = 0, revolutions: float = 2.0) -> Path:
-    """Piston acceleration: the whole run against time (left), and the last ``revolutions``
-    against crank angle (middle) and as an acceleration-velocity phase diagram (right). The ideal
-    (clearance-free) run is drawn black and dashed on top of the run with clearance, so both
-    stay visible where the clearance trace spikes around it."""
+def plot_piston(hist, ideal, path: Path, piston: int = 0, revolutions: float = 2.0,
+                window=None) -> Path:
+    """Piston acceleration: the whole run against time (left; the statistics ``window``, s,
+    shaded), and the last ``revolutions`` against crank angle (middle) and as an
+    acceleration-velocity phase diagram (right). The ideal (clearance-free) run is drawn black
+    and dashed on top of the run with clearance, so both stay visible where the clearance trace
+    spikes around it."""
     plt = _plt()
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.3))
     sel = last_revolutions(hist, revolutions)
@@ -54,6 +65,7 @@ def plot_piston(hist, ideal, path: Path, piston: int = 0, revolutions: float = 2
         ax[1].plot(ideg, ideal.piston_acceleration[isel, piston], **kw)
         ax[2].plot(ideal.piston_velocity[isel, piston], ideal.piston_acceleration[isel, piston],
                    **kw)
+    mark_window(ax[0], window)
     ax[0].set(xlabel="t [s]", ylabel="piston acceleration [m/s²]",
               title=f"piston {piston + 1}, whole run")
     ax[1].set(xlabel="crank angle turned in the window [°]", ylabel="piston acceleration [m/s²]",
@@ -64,14 +76,21 @@ def plot_piston(hist, ideal, path: Path, piston: int = 0, revolutions: float = 2
     return _save(plt, fig, path)
 
 
-def plot_bearing_force(hist, spectrum, path: Path, ideal_spectrum=None) -> Path:
-    """Main-bearing force components over time and their amplitude spectrum (Hz and orders)."""
+def plot_bearing_force(hist, spectrum, path: Path, ideal_spectrum=None, ideal=None,
+                       window=None) -> Path:
+    """Main-bearing force components over time (the ``ideal``-joint run dashed black, the
+    statistics ``window``, s, shaded) and their amplitude spectrum over the window (Hz and
+    orders)."""
     plt = _plt()
     fig, ax = plt.subplots(1, 2, figsize=(11, 4))
     ax[0].plot(hist.t, hist.main_bearing_force[:, 0], lw=0.7, label="F_x")
     ax[0].plot(hist.t, hist.main_bearing_force[:, 1], lw=0.7, label="F_y")
+    if ideal is not None:
+        ax[0].plot(ideal.t, ideal.main_bearing_force[:, 0], "k--", lw=0.9, label="ideal joints")
+        ax[0].plot(ideal.t, ideal.main_bearing_force[:, 1], "k--", lw=0.9)
+    mark_window(ax[0], window)
     ax[0].set(xlabel="t [s]", ylabel="main-bearing force [N]")
-    ax[0].legend()
+    ax[0].legend(fontsize=8)
     f = spectrum.frequency_hz
     if ideal_spectrum is not None:
         ax[1].semilogy(ideal_spectrum.frequency_hz, ideal_spectrum.amplitude[:, 0] + 1e-9, "k--",
@@ -127,24 +146,36 @@ def plot_orbit(hist, clearances, path: Path, revolutions: float = 2.0) -> Path:
     return _save(plt, fig, path)
 
 
-def plot_contact(hist, path: Path) -> Path:
-    """Normal contact force and penetration of each clearance joint, impacts marked."""
+def plot_contact(hist, path: Path, ideal=None, window=None) -> Path:
+    """Per clearance joint: the contact normal force (and the oil film's force, if any)
+    against the force the ``ideal`` pin carries there (dashed black), impacts marked, and the
+    penetration; the statistics ``window``, s, shaded."""
     plt = _plt()
     fig, ax = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     for name, d in hist.contact.items():
-        ax[0].plot(hist.t, d["fn"], lw=0.7, label=name)
+        ax[0].plot(hist.t, d["fn"], lw=0.7, label=f"{name} contact")
+        film = d.get("film_force")
+        if film is not None and np.any(np.asarray(film) > 0.0):
+            ax[0].plot(hist.t, film, lw=0.7, label=f"{name} oil film")
+        if ideal is not None and name in ideal.joint_forces:
+            f = ideal.joint_forces[name]
+            ax[0].plot(ideal.t, np.hypot(f[:, 0], f[:, 1]), "k--", lw=0.9,
+                       label=f"{name}, ideal pin")
         ax[1].plot(hist.t, np.maximum(d["penetration"], 0.0) * 1e6, lw=0.7, label=name)
         ons = np.asarray(hist.onsets.get(name, []), float).reshape(-1, 2)
         if ons.size:
             ax[0].plot(ons[:, 0], np.zeros(len(ons)), "rv", ms=3)
-    ax[0].set(ylabel="normal force [N]")
+    for k, a in enumerate(ax):
+        mark_window(a, window, label=k == 0)
+    ax[0].set(ylabel="joint force [N]")
     ax[1].set(xlabel="t [s]", ylabel="penetration [µm]")
-    ax[0].legend()
+    ax[0].legend(fontsize=8)
     return _save(plt, fig, path)
 
 
-def plot_drive(hist, ideal, path: Path) -> Path:
-    """Drive torque and power against time."""
+def plot_drive(hist, ideal, path: Path, window=None) -> Path:
+    """Drive torque and power against time (ideal joints dashed, the statistics ``window``,
+    s, shaded)."""
     plt = _plt()
     fig, ax = plt.subplots(2, 1, figsize=(10, 6), sharex=True)
     if ideal is not None:
@@ -152,18 +183,24 @@ def plot_drive(hist, ideal, path: Path) -> Path:
         ax[1].plot(ideal.t, ideal.drive_power, "k--", lw=0.8)
     ax[0].plot(hist.t, hist.drive_torque, lw=0.7, label="with clearance")
     ax[1].plot(hist.t, hist.drive_power, lw=0.7)
+    for k, a in enumerate(ax):
+        mark_window(a, window, label=k == 0)
     ax[0].set(ylabel="drive torque [N m]")
     ax[1].set(xlabel="t [s]", ylabel="drive power [W]")
     ax[0].legend()
     return _save(plt, fig, path)
 
 
-def plot_energy(hist, path: Path) -> Path:
-    """Energy bookkeeping: every term and the balance residual."""
+def plot_energy(hist, path: Path, ideal=None, window=None) -> Path:
+    """Energy bookkeeping: every term and the balance residual; the ``ideal``-joint run's
+    kinetic energy dashed black, the statistics ``window``, s, shaded."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(10, 4.5))
     for k, v in hist.energy.items():
         ax.plot(hist.t, v, lw=1.2 if k == "residual" else 0.8, label=k)
+    if ideal is not None and "kinetic" in ideal.energy:
+        ax.plot(ideal.t, ideal.energy["kinetic"], "k--", lw=0.9, label="kinetic, ideal joints")
+    mark_window(ax, window)
     ax.set(xlabel="t [s]", ylabel="energy [J]")
     ax.legend(fontsize=7)
     return _save(plt, fig, path)

@@ -121,15 +121,21 @@ def short_contact_warning(cj, duration: float, dt: float) -> str:
 
 
 def _window(hist, p, rev_hz):
-    """Sample mask of the spectrum window: a whole number of revolutions after the start-up."""
-    t0 = p["spectrum_start"]
-    if t0 is None:
-        t0 = p["ramp_time"] + 1.0 / rev_hz
-        if t0 >= hist.t[-1] - 1.0 / rev_hz:
-            t0 = p["ramp_time"]
-    n_rev = int(np.floor((hist.t[-1] - t0) * rev_hz + 1e-9))
-    t1 = t0 + n_rev / rev_hz if n_rev >= 1 else hist.t[-1]
-    return (hist.t >= t0 - 1e-12) & (hist.t <= t1 + 1e-12), n_rev
+    """Sample mask of the results window (:func:`.stats.results_window`: whole revolutions
+    after the start-up), its number of revolutions and whether it had to include the start-up."""
+    from .stats import results_window
+
+    t0, t1, n_rev, start_up = results_window(hist.t, p["ramp_time"], p["spectrum_start"], rev_hz)
+    return (hist.t >= t0 - 1e-12) & (hist.t <= t1 + 1e-12), n_rev, start_up
+
+
+def _start_up_warning(p, rev_hz) -> str:
+    """The results window had to open at the ramp's end: the run is too short."""
+    need = p["ramp_time"] + 2.0 / rev_hz
+    return (f"dynamics.end_time: {p['end_time']:g} s leaves no whole revolution after the "
+            f"ramp ({p['ramp_time']:g} s) and one settling revolution, so the results window "
+            f"(peaks, spectrum, statistics) opens at {p['ramp_time']:g} s and includes the "
+            f"start-up transient; give end_time >= {need:.4g} s or a spectrum_start")
 
 
 def run(params: dict, ctx) -> dict:
@@ -177,13 +183,9 @@ def run(params: dict, ctx) -> dict:
     for text in timescales.check_budget(scales, t_end, settings.method, settings.max_rhs_evals):
         warn(text, into=early_warnings)
     start_info = None
+    mech.start = p["flexible"]["start"]  # simulate() leaves an "undeformed" start as built
     if bodies is not None and p["flexible"]["start"] == "quasi_static":
-        from .initial import quasi_static_start
-
-        # solved on the ideal-joint twin (same bodies and coordinates, every clearance joint a
-        # pin): across a clearance the Newton steps found spurious states balanced by the
-        # contact or film force past the wall (the loom's coupler pin C: 165 % of its clearance)
-        mech.q0, mech.qd0, start_info = quasi_static_start(mech.ideal, mech.q0, mech.qd0)
+        start_info = mech.start_quasi_static()  # on the ideal-joint twin, as simulate() does
     elif bodies is not None and p["ramp_time"] == 0.0:
         text = _start_warning(mech, p, rev_hz)
         if text:
@@ -201,22 +203,29 @@ def run(params: dict, ctx) -> dict:
                             twin=True)
         rigid_settings = replace(solver_settings(p, 60.0 * rev_hz), time_scales=tuple(scales))
         rigid = simulate(rigid_mech, t_end, dt, rigid_settings, energy_tolerance=tol)
-    sel, n_rev = _window(hist, p, rev_hz)
+    sel, n_rev, start_up = _window(hist, p, rev_hz)
+    if start_up:
+        warn(_start_up_warning(p, rev_hz), into=early_warnings)
     orders = list(range(13))
     res = {"mechanism": mech.kind, "speed_rpm": 60.0 * rev_hz, "revolution_hz": rev_hz,
            "end_time_s": t_end, "output_step_s": dt, "rhs_evals": hist.nfev,
            "integration_wall_time_s": hist.wall_time, "solver_method": settings.method}
     f = hist.main_bearing_force
-    # peaks: the samples and each contact's deepest point (an event: samples miss short impacts)
-    res["main_bearing_force_peak_n"] = hist.peak("main_bearing_force", np.hypot(f[:, 0], f[:, 1]))
+    # peaks: in the results window (the start-up left out, as for every other number), the
+    # samples and each contact's deepest point (an event: samples miss short impacts)
+    tw = (float(hist.t[sel][0]), float(hist.t[sel][-1]))
+    res["peak_window_s"] = list(tw)
+    res["main_bearing_force_peak_n"] = hist.peak("main_bearing_force",
+                                                 np.hypot(f[sel, 0], f[sel, 1]), None, *tw)
     mm = hist.main_bearing_moment
-    res["main_bearing_moment_peak_nm"] = float(np.max(np.hypot(mm[:, 0], mm[:, 1])))
+    res["main_bearing_moment_peak_nm"] = float(np.max(np.hypot(mm[sel, 0], mm[sel, 1])))
     if n_rev >= 1:
         amps = order_amplitudes(hist.t[sel], f[sel], rev_hz, orders)
         res["main_bearing_orders"] = orders
         res["main_bearing_order_amplitude_n"] = amps.tolist()  # rows: order; columns: x, y
     res["piston_acceleration_peak"] = hist.peak("piston_acceleration",
-                                                hist.piston_acceleration).tolist()
+                                                hist.piston_acceleration[sel], None,
+                                                *tw).tolist()
     res["angular_acceleration_peak"] = {name: float(np.max(np.abs(v[sel])))
                                         for name, v in hist.angular_acceleration.items()}
     res["drive_torque_peak_nm"] = float(np.max(np.abs(hist.drive_torque[sel])))
@@ -232,15 +241,18 @@ def run(params: dict, ctx) -> dict:
         dur = contact_durations(hist.onsets[cj.name], hist.separations[cj.name])
         j = {"clearance_m": cj.clearance, "law": cj.law,
              "stiffness": float(cj.law_params["stiffness"]),
-             "peak_contact_force_n": hist.peak("fn", d["fn"], cj.name),
-             "max_penetration_m": hist.peak("penetration", np.maximum(d["penetration"], 0.0),
-                                            cj.name),
+             "peak_contact_force_n": hist.peak("fn", d["fn"][sel], cj.name, *tw),
+             "max_penetration_m": hist.peak("penetration",
+                                            np.maximum(d["penetration"][sel], 0.0), cj.name, *tw),
              "contact_fraction": float(np.mean(d["penetration"][sel] > 0.0)),
              "contact_duration_median_s": float(np.median(dur)) if dur.size else None}
         j.update(impact_statistics(hist.onsets[cj.name], v_min=cj.v_impact_min))
         if dur.size and np.median(dur) < 2.0 * dt:
             warn(short_contact_warning(cj, float(np.median(dur)), dt), into=res["warnings"])
-        text = penetration_warning(cj, j["max_penetration_m"], j["peak_contact_force_n"],
+        # validity over the whole run, the start-up included: a law outside it there is too
+        text = penetration_warning(cj, hist.peak("penetration",
+                                                 np.maximum(d["penetration"], 0.0), cj.name),
+                                   hist.peak("fn", d["fn"], cj.name),
                                    p["contact"]["E"], p["contact"]["nu"])
         if text:
             warn(text, into=res["warnings"])
@@ -258,12 +270,22 @@ def run(params: dict, ctx) -> dict:
         res["ensemble"] = run_ensemble(mech, res["statistics"], p["ensemble"], t_end, dt,
                                        settings, rev_hz, float(hist.t[sel][0]), v_min,
                                        energy_tolerance=tol)
-    if ideal is not None:
-        res["ideal"] = {"main_bearing_force_peak_n": float(np.max(np.hypot(
-            ideal.main_bearing_force[:, 0], ideal.main_bearing_force[:, 1]))),
-            "piston_acceleration_peak": np.max(np.abs(ideal.piston_acceleration), axis=0).tolist()
-            if ideal.piston_acceleration.size else [],
-            "drive_power_mean_w": float(np.mean(ideal.drive_power[sel]))}
+    from .ensemble import headlines
+
+    res["headline"] = headlines(res["statistics"], res.get("ensemble"))
+    if ideal is not None:  # the same window as the run with clearance
+        fi = ideal.main_bearing_force[sel]
+        res["ideal"] = {"main_bearing_force_peak_n": float(np.max(np.hypot(fi[:, 0], fi[:, 1]))),
+                        "piston_acceleration_peak":
+                            np.max(np.abs(ideal.piston_acceleration[sel]), axis=0).tolist()
+                            if ideal.piston_acceleration.size else [],
+                        "drive_power_mean_w": float(np.mean(ideal.drive_power[sel]))}
+        ist = statistics(ideal, rev_hz, float(hist.t[sel][0]), v_min)
+        res["ideal"]["main_bearing_per_rev_peak_n"] = ist["main_bearing_force"]["per_rev_peak"]["mean"]
+        res["ideal"]["main_bearing_rms_n"] = ist["main_bearing_force"]["rms"]["mean"]
+        for key, h in res["headline"].items():
+            if key in res["ideal"]:
+                h["ideal"] = res["ideal"][key]
     if bodies is not None:
         from .flexstage import flexible_results
 
@@ -316,7 +338,13 @@ def run(params: dict, ctx) -> dict:
         motion = f"piston accel peak {k['peak_piston_acceleration']:.4g} m/s^2"
     else:
         motion = f"rocker accel peak {res['angular_acceleration_peak'].get('rocker', 0.0):.4g} rad/s^2"
-    if mech.system.clearances and res["statistics"]["window"]["n_revolutions"] >= 2:
+    if "ensemble" in res and n_rev >= 1 and study is None:
+        # one value per quantity, with the ensemble's spread where the trajectories disagree
+        # (with a tolerance study: its convergence summary over the ensemble, below)
+        from .ensemble import headline_text as ensemble_text
+
+        headline_text = ensemble_text(res["headline"], n_rev)
+    elif mech.system.clearances and res["statistics"]["window"]["n_revolutions"] >= 2:
         # a clearance run: one trajectory's peak is not a result, the per-revolution mean is
         headline_text = converged_summary(res["statistics"], study, settings.rtol,
                                           res.get("ensemble", {}).get("n_trajectories"))
@@ -325,10 +353,9 @@ def run(params: dict, ctx) -> dict:
     res["summary"] = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {t_end:g} s: {headline_text}, "
                       f"{n_imp} impacts, energy balance {res['energy_balance_error']:.1e}")
     if "ensemble" in res:
-        e = res["ensemble"]["spread"]["main_bearing_per_rev_peak_n"]
-        res["summary"] += (f"; over {p['ensemble']} trajectories (start perturbed at 1e-12): "
-                           f"main-bearing per-rev peak {e['mean']:.4g} N, spread "
-                           f"{e['min']:.4g}-{e['max']:.4g} N")
+        e = res["headline"]["main_bearing_per_rev_peak_n"]
+        res["summary"] += (f"; {p['ensemble']} trajectories started 1e-12 apart give "
+                           f"main-bearing per-rev peaks {e['min']:.4g}-{e['max']:.4g} N")
     if bodies is not None:
         names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in res["flexible"]["bodies"].items())
         res["summary"] += f"; flexible: {names}"
@@ -366,15 +393,17 @@ def _figures(hist, ideal, mech, sel, study, out, spec=None):
         spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev)
     ispec = None if ideal is None else amplitude_spectrum(ideal.t[sel],
                                                           ideal.main_bearing_force[sel], rev)
-    figs.append(plots.plot_bearing_force(hist, spec, out / "dynamics_main_bearing.png", ispec))
+    window = (float(hist.t[sel][0]), float(hist.t[sel][-1]))  # shaded on every time plot
+    figs.append(plots.plot_bearing_force(hist, spec, out / "dynamics_main_bearing.png", ispec,
+                                         ideal, window))
     if hist.piston_acceleration.shape[1]:
-        figs.append(plots.plot_piston(hist, ideal, out / "dynamics_piston.png"))
+        figs.append(plots.plot_piston(hist, ideal, out / "dynamics_piston.png", window=window))
     if mech.system.clearances:
         cl = {cj.name: cj.clearance for cj in mech.system.clearances}
         figs.append(plots.plot_orbit(hist, cl, out / "dynamics_orbit.png"))
-        figs.append(plots.plot_contact(hist, out / "dynamics_contact.png"))
-    figs.append(plots.plot_drive(hist, ideal, out / "dynamics_drive.png"))
-    figs.append(plots.plot_energy(hist, out / "dynamics_energy.png"))
+        figs.append(plots.plot_contact(hist, out / "dynamics_contact.png", ideal, window))
+    figs.append(plots.plot_drive(hist, ideal, out / "dynamics_drive.png", window))
+    figs.append(plots.plot_energy(hist, out / "dynamics_energy.png", ideal, window))
     if study is not None:
         figs.append(plots.plot_study(study, out / "dynamics_tolerance_study.png"))
     return [f.name for f in figs]

@@ -42,6 +42,56 @@ def revolution_blocks(t, t_start: float, revolution_hz: float) -> tuple[np.ndarr
     return block_of(t, t_start, revolution_hz, n), n
 
 
+def results_window(t, ramp_time: float, spectrum_start: float | None,
+                   revolution_hz: float) -> tuple[float, float, int, bool]:
+    """The results (statistics) window of a run: whole revolutions after the start-up.
+
+    By default the window opens one revolution after the speed ramp (``ramp_time``), the
+    start-up transient left out, and holds every whole revolution that fits before the last
+    output time; ``spectrum_start`` (s) opens it there instead. A run too short for one whole
+    revolution after that settling revolution opens the window at the ramp's end instead
+    (the start-up included: the caller warns). "Fits" has a round-off slack of 1e-9 revolution:
+    a run of exactly ``ramp_time`` + 2 revolutions has one whole revolution after the settling
+    one, whatever the last bit of its output times.
+
+    Parameters
+    ----------
+    t : (K,) output times, s, increasing.
+    ramp_time : float
+        s, end of the speed ramp.
+    spectrum_start : float or None
+        s, explicit start of the window.
+    revolution_hz : float
+        Hz.
+
+    Returns
+    -------
+    start_s, end_s : float
+        s; ``end_s`` is ``start_s`` + ``n_revolutions`` revolutions (the last output time when
+        no whole revolution fits).
+    n_revolutions : int
+        Whole revolutions in the window (0 when none fits).
+    includes_start_up : bool
+        The default window had to open at the ramp's end, before the settling revolution.
+    """
+    t = np.asarray(t, float)
+    t_last = float(t[-1]) if t.size else 0.0
+
+    def whole(t0):
+        return max(int(np.floor((t_last - t0) * revolution_hz + 1e-9)), 0)
+
+    start_up = False
+    if spectrum_start is not None:
+        t0 = float(spectrum_start)
+    else:
+        t0 = float(ramp_time) + 1.0 / revolution_hz
+        if whole(t0) < 1:
+            t0, start_up = float(ramp_time), True
+    n = whole(t0)
+    t1 = t0 + n / revolution_hz if n >= 1 else t_last
+    return t0, t1, n, start_up
+
+
 def block_of(times, t_start: float, revolution_hz: float, n: int) -> np.ndarray:
     """Revolution index (0 .. n-1, else -1) of arbitrary times, s (e.g. events)."""
     b = np.floor((np.asarray(times, float) - t_start) * revolution_hz + 1e-9).astype(int)
