@@ -11,7 +11,7 @@ carries no damping, and the first free-free mode (its 19 %) has 2.27 times the f
 zeta_eff = 0.431 zeta. The code solves the damped eigenproblem of the body built from the same
 free-free modes with its end translations held (another formulation: constraint null space and
 a state-space eigenvalue), which agrees to the O(zeta^2) of the perturbation and the modal
-truncation (measured 2e-4).
+truncation (measured 7e-4; the frequency 2.3e-4).
 """
 
 import numpy as np
