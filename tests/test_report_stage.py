@@ -172,3 +172,45 @@ def test_a_static_scene_without_modal_reports_part_material_and_stress_with_its_
     assert res["report"]["von_mises_render"] == "von_mises.png"
     assert re.search(r"<h1>Report: ", html) and res["report"]["sections"] == ["geometry",
                                                                               "material", "static"]
+
+
+def _embedded(html: str) -> list[bytes]:
+    import base64
+
+    return [base64.b64decode(m) for m in re.findall(r'<img src="data:image/\w+;base64,([^"]+)"',
+                                                     html)]
+
+
+def test_measured_verdicts_name_their_tolerance_and_agree_with_it(bar_report):
+    """Issue 25 #15: a difference from the measured frequency is judged against
+    report.tolerance (5 % by default), and the row says so."""
+    out, res = bar_report
+    html = (out / "report.html").read_text()
+    f = res["modal"]["frequencies_hz"]
+    assert "against the tolerance ±5 % (report.tolerance)" in html
+    for k, measured in enumerate([1200.0, 1700.0]):
+        err = f[k] / measured - 1.0
+        row = re.search(rf"<tr><td class=\"n\">{k + 1}</td><td class=\"n\">{measured:.1f}</td>"
+                        rf"(.*?)</tr>", html).group(1)
+        assert ("within ±5 %" if abs(err) <= 0.05 else "OUTSIDE ±5 %") in row
+    cmp = res["report"]["measured_comparison"]
+    assert [r["ok"] for r in cmp] == [abs(f[k] / m - 1.0) <= 0.05
+                                      for k, m in enumerate([1200.0, 1700.0])]
+    assert all(r["rtol"] == 0.05 for r in cmp)
+
+
+def test_each_mode_render_is_shown_once(bar_report, tmp_path):
+    """Issue 25 #15: the contact sheet holds every mode, so the single renders are not embedded
+    again; with gif = true the animations show the modes, and neither sheet nor stills."""
+    out, res = bar_report
+    pics = _embedded((out / "report.html").read_text())
+    assert pics.count((out / "mode_sheet.png").read_bytes()) == 1
+    for name in res["report"]["renders"]:
+        assert (out / name).read_bytes() not in pics
+    res = run(_scene(tmp_path, {"gif": True, "max_renders": 2, "stress": False}),
+              tmp_path / "out")
+    pics = _embedded((tmp_path / "out" / "report.html").read_text())
+    gifs = [(tmp_path / "out" / g).read_bytes() for g in res["report"]["gifs"]]
+    assert len(gifs) == 2 and all(pics.count(g) == 1 for g in gifs)
+    for name in res["report"]["renders"] + ["mode_sheet.png"]:
+        assert (tmp_path / "out" / name).read_bytes() not in pics
