@@ -37,7 +37,7 @@ def plot_interference(res, natural_hz, operating, band, path: str | Path) -> Pat
         lc = LineCollection(segs, cmap="viridis", norm=norm, lw=2.0)
         lc.set_array(np.clip(torque[:-1, j], vmax * 1e-3, None))
         ax.add_collection(lc)
-        ax.text(n[-1], f[-1], f" {q:g}", fontsize=7, va="center")
+        ax.text(n[-1], f[-1], f" {q:g}", fontsize=7, va="center", clip_on=True)
     for f in natural_hz:
         if f <= fmax * 1.05:
             ax.axhline(f, color="C3", lw=1.0, ls="--")
