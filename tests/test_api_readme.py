@@ -1,7 +1,7 @@
-"""The README's "Python API" section runs as printed: every ```python block under that heading,
-in order, in one namespace, in a temporary folder (each block asserts its numbers against an
-independent oracle: CAD mass, F/A, Rayleigh-Ritz bounds, the two-rotor closed form, the
-main-bearing force at top dead centre)."""
+"""The docs' "Python API by example" page (docs/guide/api_examples.md, the README's former "Python
+API" section) runs as printed: every ```python block of the page, in order, in one namespace, in
+a temporary folder (each block asserts its numbers against an independent oracle: CAD mass, F/A,
+Rayleigh-Ritz bounds, the two-rotor closed form, the main-bearing force at top dead centre)."""
 
 import os
 import re
@@ -9,34 +9,44 @@ from pathlib import Path
 
 import pytest
 
-README = Path(__file__).resolve().parent.parent / "README.md"
-HEADING = "## Python API"
+PAGE = Path(__file__).resolve().parent.parent / "docs" / "guide" / "api_examples.md"
+HEADING = "# Python API by example"
 
 
 def api_blocks(text: str) -> list[str]:
-    """The ```python blocks between ``## Python API`` and the next level-2 heading."""
-    start = text.find("\n" + HEADING + "\n")
-    if start < 0:
-        return []
-    section = text[start + 1:]
-    nxt = re.search(r"^## ", section[len(HEADING):], re.MULTILINE)
-    if nxt:
-        section = section[:len(HEADING) + nxt.start()]
-    return re.findall(r"^```python\n(.*?)^```", section, re.DOTALL | re.MULTILINE)
+    """The ```python blocks between ``HEADING`` and the next heading of its level or above
+    (lines inside fences, such as ``# comments`` in code, are not headings)."""
+    level = len(HEADING.split(" ")[0])
+    blocks, inside, fence, lang, body = [], False, False, "", []
+    for line in text.splitlines(keepends=True):
+        if line.startswith("```"):
+            if not fence:
+                fence, lang, body = True, line[3:].strip(), []
+            else:
+                fence = False
+                if inside and lang == "python":
+                    blocks.append("".join(body))
+            continue
+        if fence:
+            body.append(line)
+            continue
+        m = re.match(r"^(#+) ", line)
+        if m and len(m.group(1)) <= level:
+            inside = line.rstrip("\n") == HEADING
+    return blocks
 
 
 def test_api_blocks_are_found_in_a_section_and_only_there():
-    text = ("# x\n```python\nA\n```\n## Python API\nintro\n```python\nB = 1\n```\n"
-            "### sub\n```python\nC = 2\n```\n## Next\n```python\nD\n```\n")
+    text = ("x\n```python\nA\n```\n# Python API by example\nintro\n```python\nB = 1\n```\n"
+            "## sub\n```python\nC = 2\n```\n# Next\n```python\nD\n```\n")
     assert api_blocks(text) == ["B = 1\n", "C = 2\n"]
+    assert api_blocks(text[text.index("# Python"):]) == ["B = 1\n", "C = 2\n"]
     assert api_blocks("# no such section\n```python\nA\n```\n") == []
 
 
 def _readme_blocks() -> list[str]:
-    blocks = api_blocks(README.read_text(encoding="utf-8"))
-    if not blocks:
-        pytest.skip(f"README.md has no '{HEADING}' section with python blocks yet "
-                    "(its text is in /work/helpers/readme_C.md until merged)")
+    blocks = api_blocks(PAGE.read_text(encoding="utf-8"))
+    assert len(blocks) >= 5, f"{PAGE.name}: its python blocks under '{HEADING}' are missing"
     return blocks
 
 
@@ -56,4 +66,4 @@ def test_readme_python_api_examples_run(tmp_path, monkeypatch):
     monkeypatch.setenv("MPLBACKEND", os.environ.get("MPLBACKEND", "Agg"))
     namespace: dict = {"__name__": "readme_python_api"}
     for i, code in enumerate(blocks):
-        exec(compile(code, f"README.md {HEADING} block {i + 1}", "exec"), namespace)  # noqa: S102
+        exec(compile(code, f"{PAGE.name} block {i + 1}", "exec"), namespace)  # noqa: S102

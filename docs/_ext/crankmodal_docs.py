@@ -4,6 +4,8 @@
   (:data:`SCENE_TABLES`): type, default, unit/meaning (the key's ``doc``), bounds and choices.
 * ``validation.md`` -- the oracle table per stage from ``validation/oracles.json``, which the test
   suite writes (``CRANKMODAL_ORACLES=docs/validation/oracles.json``, see ``tests/conftest.py``).
+* ``reference/api.md`` -- an autosummary of every name in ``crankmodal.__all__``, grouped by the
+  subpackage it comes from, so a newly exported name is documented without editing a page.
 * ``gallery/*.ipynb`` -- copies of ``notebooks/*.ipynb`` (Sphinx reads only its source folder;
   a copy instead of a symlink works on every file system). The notebooks are shown with the
   outputs they carry (``nb_execution_mode = "off"``).
@@ -216,6 +218,70 @@ def validation_markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+#: (title, what, home subpackages): the API reference's groups, in reading order
+API_GROUPS = [
+    ("Scenes and runs", "Load, check and run scenes; machine files.",
+     ("scene", "runner", "resources", "cli")),
+    ("Geometry", "Parametric parts, meshing, CAD and mesh import.", ("geometry", "part")),
+    ("Finite elements", "Materials, assembly, supports and loads, modes and static solves.",
+     ("fem",)),
+    ("Reduction", "Craig-Bampton flexible bodies and their files.", ("reduction",)),
+    ("Mechanism", "Kinematics and forces of crank mechanisms.", ("mechanism",)),
+    ("Torsion", "Torsional chains, Ker Wilson crank models, critical speeds.", ("torsion",)),
+    ("Dynamics", "Bodies, joints, contact and friction laws, mechanisms and the integrator.",
+     ("dynamics",)),
+    ("Reports and sweeps", "The report and the sweep engine.", ("report", "sweep")),
+    ("Errors", "What crankmodal raises; the command line maps them to exit statuses.",
+     ("errors",)),
+]
+
+
+def _home(name: str) -> str:
+    """The crankmodal subpackage (or top-level module) that defines public ``name``."""
+    import crankmodal
+
+    obj = getattr(crankmodal, name)
+    module = getattr(obj, "__module__", None) or "crankmodal"
+    if not module.startswith("crankmodal."):
+        table = getattr(crankmodal, "_EXPORTS", {})
+        module = table.get(name, module) if isinstance(table, dict) else module
+        module = module if isinstance(module, str) else "crankmodal"
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def api_markdown() -> str:
+    """The API reference page: every public name, grouped by its home subpackage."""
+    import crankmodal
+
+    names = [n for n in crankmodal.__all__ if n != "__version__"]
+    groups: dict[str, list[str]] = {g[0]: [] for g in API_GROUPS}
+    other = []
+    for name in names:
+        home = _home(name)
+        for title, _, homes in API_GROUPS:
+            if home in homes:
+                groups[title].append(name)
+                break
+        else:
+            other.append(name)
+    lines = ["# API reference", "",
+             "Every public name of `crankmodal` (the names in `crankmodal.__all__`, generated "
+             "from it at build time; `import crankmodal` is cheap and each name is imported from "
+             "its home module on first use). Units are SI (m, kg, s, N, Pa, rad; Hz where a name "
+             "says so). `crankmodal.__version__` is the installed version. Worked examples are in "
+             "[Python API by example](../guide/api_examples.md).", ""]
+    for title, text, _ in API_GROUPS + [("Other", "", ())]:
+        members = groups.get(title, other if title == "Other" else [])
+        if not members:
+            continue
+        lines += [f"## {title}", "", text, "", "```{eval-rst}", ".. currentmodule:: crankmodal",
+                  "", ".. autosummary::", "   :toctree: generated", "   :nosignatures:", ""]
+        lines += [f"   {n}" for n in sorted(members, key=lambda n: (n[0].islower(), n.lower()))]
+        lines += ["```", ""]
+    return "\n".join(lines)
+
+
 def _write_if_changed(path: Path, text: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     if not path.exists() or path.read_text(encoding="utf-8") != text:
@@ -237,10 +303,13 @@ def copy_notebooks(dest: Path) -> list[str]:
 def generate(app=None) -> None:
     """Write the generated pages into the source folder (before Sphinx reads it)."""
     _write_if_changed(DOCS / "reference" / "scene.md", scene_markdown())
+    _write_if_changed(DOCS / "reference" / "api.md", api_markdown())
     _write_if_changed(DOCS / "validation.md", validation_markdown(load_oracles()))
     copy_notebooks(DOCS / "gallery" / "notebooks")
 
 
 def setup(app):
-    app.connect("builder-inited", generate)
+    # config-inited: before Sphinx lists the source files and autosummary reads api.md for its
+    # stubs (a fresh clone has none of the generated pages)
+    app.connect("config-inited", lambda app, config: generate(app))
     return {"parallel_read_safe": True, "parallel_write_safe": True}
