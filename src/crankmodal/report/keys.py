@@ -41,8 +41,9 @@ SCHEMA: dict[str, Field] = {
                              "full model), measured", choices=("auto", "computed", "measured")),
     "compared_modes": Field("int", None, "modes entering a model's error (default: the measured "
                             "ones, else all tabulated)", ge=1),
-    "tolerance": Field("float", 0.05, "admissible relative frequency error for the study's "
-                       "recommendation", gt=0.0, lt=1.0),
+    "tolerance": Field("float", 0.05, "admissible relative frequency error |f - f_ref| / f_ref: "
+                       "the verdict of each measured_hz value and the study's recommendation",
+                       gt=0.0, lt=1.0),
 }
 
 

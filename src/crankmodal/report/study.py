@@ -30,6 +30,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .quantity import percent, quantity
+
 #: Smallest MAC accepted to pair a model's mode with a reference mode.
 MIN_PAIR_MAC = 0.6
 
@@ -152,12 +154,12 @@ class SimplificationStudy:
     def recommendation_text(self) -> str:
         if self.recommended is None:
             best = int(np.argmin([r["error"] for r in self.runs]))
-            return (f"no model is within the tolerance of {100 * self.tolerance:.3g} %; the most "
+            return (f"no model is within the tolerance of {percent(self.tolerance)}; the most "
                     f"accurate is {self.label(self.runs[best])} "
-                    f"({100 * self.runs[best]['error']:.3g} %)")
+                    f"({percent(self.runs[best]['error'])})")
         r = self.runs[self.recommended]
-        return (f"{self.label(r)}: estimated error {100 * r['error']:.3g} % <= "
-                f"{100 * self.tolerance:.3g} % in {r['wall_time_s']:.3g} s "
+        return (f"{self.label(r)}: estimated error {percent(r['error'])} <= "
+                f"{percent(self.tolerance)} in {quantity(r['wall_time_s'], 's', 3)} "
                 f"({r['n_elements']} elements, {r['n_dofs']} DOF)")
 
     def to_dict(self) -> dict:
@@ -190,7 +192,7 @@ class SimplificationStudy:
                 " (Pareto)" if i in self.pareto else "")
             rows.append([f"{self.label(r)}{mark}", r["n_elements"], r["n_dofs"],
                          f"{r['wall_time_s']:.3g}"] + [cell(r, k) for k in range(n)]
-                        + [f"{100 * r['error']:.2g} %"])
+                        + [percent(r["error"], 2)])
         return head, rows
 
     def table_markdown(self, measured_hz=None) -> str:
