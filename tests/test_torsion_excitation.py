@@ -29,7 +29,7 @@ def _rod(length, mass=0.0):
     return Rod(length=length, mass=mass, cg_from_big_end=l1, inertia=mass * l1 * (length - l1))
 
 
-def test_single_compressor_cylinder_mean_effort_times_omega_is_indicated_power_1e6():
+def test_single_compressor_cylinder_mean_effort_times_omega_is_indicated_power_1e6(oracle):
     r, lam, n_exp = 0.06, 0.25, 1.3
     ps, pd, eps = 1.0e5, 4.0e5, 0.06
     cyl = Cylinder(bank_angle=0.0, axial_offset=0.0, throw_angle=0.0, piston_mass=5.0, bore=0.12,
@@ -42,11 +42,14 @@ def test_single_compressor_cylinder_mean_effort_times_omega_is_indicated_power_1
     vs = cyl.area * 2 * r
     v1, v4 = vs * (1 + eps), vs * eps * (pd / ps) ** (1 / n_exp)
     work = n_exp / (n_exp - 1) * ps * (v1 - v4) * ((pd / ps) ** ((n_exp - 1) / n_exp) - 1)
+    oracle(stage="torsion", quantity="mean tangential effort x omega, one compressor cylinder",
+           reference="closed-form indicated power of the ideal polytropic cycle", tolerance="1e-6 rel",
+           measured=power, expected=work * m.speed_rpm / 60.0)
     assert power == pytest.approx(work * m.speed_rpm / 60.0, rel=1e-6)
 
 
 @pytest.mark.parametrize("lam", [0.1, 0.2])
-def test_inertia_torque_orders_match_series_in_lambda(lam):
+def test_inertia_torque_orders_match_series_in_lambda(lam, oracle):
     # T = -m a dx/dpsi = -(m/2) d(v^2)/dpsi with v/(r omega) = sin t + lam sin t cos t (1 - lam^2
     # sin^2 t)^(-1/2); expanding v^2 to lam^3 and differentiating, in units m r^2 omega^2:
     # T = (lam/4 + lam^3/16) sin t - 1/2 sin 2t - (3 lam/4 + 9 lam^3/32) sin 3t - lam^2/4 sin 4t
@@ -60,6 +63,10 @@ def test_inertia_torque_orders_match_series_in_lambda(lam):
     cosine = h[:, 0].real / (mass * r**2)
     series = np.array([lam / 4 + lam**3 / 16, -0.5, -(3 * lam / 4 + 9 * lam**3 / 32), -lam**2 / 4])
     bound = np.array([lam**5, lam**4, 2 * lam**5, lam**4])  # the first neglected terms, O(1) coefficients
+    for k in range(4):
+        oracle(stage="torsion", quantity=f"inertia torque order {k + 1} / (m r^2 omega^2), lambda {lam:g}",
+               reference="series in lambda (hand-derived closed form)", tolerance=f"{bound[k]:.1e} abs",
+               measured=float(sine[k]), expected=float(series[k]))
     assert np.all(np.abs(sine - series) <= bound), (sine - series, bound)
     np.testing.assert_allclose(cosine, 0.0, atol=1e-12)  # odd in psi: no cosine terms
 

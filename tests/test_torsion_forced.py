@@ -42,7 +42,7 @@ def two_rotor_closed_form(w, T, c):
 
 
 @pytest.mark.parametrize("zeta", [0.0, 0.05])
-def test_two_rotor_amplitude_and_phase_match_closed_form_1e9(zeta):
+def test_two_rotor_amplitude_and_phase_match_closed_form_1e9(zeta, oracle):
     chain = TorsionalChain([I1, I2], [K])
     wn = math.sqrt(K * (I1 + I2) / (I1 * I2))
     # a modal damping ratio zeta on the one elastic mode is a dashpot 2 zeta wn J_e across the
@@ -55,6 +55,9 @@ def test_two_rotor_amplitude_and_phase_match_closed_form_1e9(zeta):
     T = 120.0 * np.exp(0.4j)
     X = harmonic_response(train, w, np.tile([T, 0.0], (len(w), 1)))
     t1, t2 = two_rotor_closed_form(w, T, c)
+    oracle(stage="torsion", quantity=f"two-rotor forced amplitude, zeta {zeta:g}",
+           reference="closed form (scalar algebra of the two-rotor equations)", tolerance="1e-9 rel",
+           measured=float(np.max(np.abs(np.concatenate([X[:, 0] / t1, X[:, 1] / t2]) - 1))), expected=0.0)
     np.testing.assert_allclose(np.abs(X[:, 0]), np.abs(t1), rtol=1e-9)
     np.testing.assert_allclose(np.abs(X[:, 1]), np.abs(t2), rtol=1e-9)
     np.testing.assert_allclose(np.angle(X[:, 0] / t1), 0.0, atol=1e-9)
@@ -78,7 +81,7 @@ def _chain4():
     return TorsionalChain([0.4, 0.25, 0.25, 1.5], [2.0e5, 1.6e5, 2.4e5])
 
 
-def test_synthesis_matches_time_integration_within_1e4_of_peak():
+def test_synthesis_matches_time_integration_within_1e4_of_peak(oracle):
     from scipy.integrate import solve_ivp
 
     chain = _chain4()
@@ -113,6 +116,9 @@ def test_synthesis_matches_time_integration_within_1e4_of_peak():
     th = sol.y[:4]
     half_ode = 0.5 * (th.max(axis=1) - th.min(axis=1))
     peak = half_ode.max()
+    oracle(stage="torsion", quantity="synthesised half peak-to-peak angle vs time integration",
+           reference="scipy DOP853 integration of the chain ODE to steady state", tolerance="1e-4 of peak",
+           measured=float(np.max(np.abs(res.amplitude_rad[0] - half_ode)) / peak), expected=0.0)
     np.testing.assert_allclose(res.amplitude_rad[0], half_ode, atol=1e-4 * peak)
     tw = chain.stiffnesses[:, None] * (th[:-1] - th[1:])
     half_t = 0.5 * (tw.max(axis=1) - tw.min(axis=1))
@@ -120,7 +126,7 @@ def test_synthesis_matches_time_integration_within_1e4_of_peak():
 
 
 @pytest.mark.parametrize("phased, bound", [(False, 1e-4), (True, 1e-3)])
-def test_energy_balance_at_resonance_matches_full_response_for_light_damping(phased, bound):
+def test_energy_balance_at_resonance_matches_full_response_for_light_damping(phased, bound, oracle):
     chain = _chain4()
     zeta = 0.01
     train = damped_train(chain, modal_damping=zeta)
@@ -132,6 +138,9 @@ def test_energy_balance_at_resonance_matches_full_response_for_light_damping(pha
     full = np.abs(harmonic_response(train, [w], F[None])[0])
     ref = int(np.argmax(np.abs(shape)))
     rel = abs(eb[ref] / full[ref] - 1)
+    oracle(stage="torsion", quantity=f"resonant amplitude, energy balance vs full ({'phased' if phased else 'in-phase'})",
+           reference="energy balance with the Holzer mode shape (second formulation)", tolerance=bound,
+           measured=rel, expected=0.0)
     # With modal damping the energy balance is exactly the resonant mode's share of the response;
     # the rest is the off-resonant modes (rigid and elastic). Under in-phase torques they move in
     # quadrature with the resonant mode and change the amplitude by O((2 zeta)^2 x their share)

@@ -232,7 +232,11 @@ def validate(tp: dict, scene, chain, model) -> dict:
     for i, n_op in enumerate(ops):
         a, b = n_op * (1 - f["speed_band"]), n_op * (1 + f["speed_band"])
         if a < speeds[0] - 1e-9 or b > speeds[-1] + 1e-9:
-            key = f"{KEY}.operating_speeds_rpm[{i}]" if f["operating_speeds_rpm"] else f"{KEY}.speed_band"
+            inside = speeds[0] - 1e-9 <= n_op <= speeds[-1] + 1e-9
+            if inside or not f["operating_speeds_rpm"]:
+                key = f"{KEY}.speed_band"  # the band, not the speed, leaves the range
+            else:
+                key = f"{KEY}.operating_speeds_rpm[{i}]"
             raise SceneError(f"{key}: the band {a:.5g}..{b:.5g} rpm around {n_op:g} rpm lies outside the "
                              f"speed range {speeds[0]:.5g}..{speeds[-1]:.5g} rpm")
     drive = f["drive_section"] or len(chain.stiffnesses)

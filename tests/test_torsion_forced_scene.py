@@ -1,0 +1,130 @@
+"""The [torsion.forced] scene section: the seed 004 train study, the peer code, bad input.
+
+- Side by side with openTorsion (Aalto University): the same train (rotor and shaft damping) gives
+  the same natural frequencies (1e-6) and, under the compressor's periodic torques, the same
+  steady state (per order and synthesised by dense sampling here, 1e-4).
+- The results.json contract fields and their shapes; every figure written.
+- Bad input through the CLI: exit 2, one line naming the key, no results.json.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from crankmodal.runner import check
+from crankmodal.scene import load_scene
+
+from conftest import SCENES, run_cli
+
+SEED = SCENES / "seed004_forced_torsion.toml"
+
+
+def _forced_params(overrides=()):
+    return check(load_scene(SEED, overrides))["torsion"]["forced"]
+
+
+def test_same_train_as_opentorsion_same_frequencies_and_steady_state(oracle):
+    ot = pytest.importorskip("opentorsion", reason="openTorsion (the peer code) is in the 'test' extra")
+    from crankmodal.torsion.forced import damped_train, steady_state
+
+    f = _forced_params()
+    chain = f["train"]  # the scene's train has modal damping; openTorsion takes element dampers
+    inertias = np.diag(chain.M)
+    ks = chain.section_stiffness
+    c_rot = [0.5, 0.5, 2.0, 0.3]  # N m s/rad, chosen for the comparison
+    c_sec = [8.0, 8.0, 6.0]
+    from crankmodal.torsion.chain import TorsionalChain
+
+    mine = damped_train(TorsionalChain(inertias, ks), modal_damping=0.0, rotor_damping=c_rot,
+                        section_damping=c_sec)
+    peer = ot.Assembly([ot.Shaft(i, i + 1, None, None, k=k, I=0.0, c=c) for i, (k, c) in enumerate(zip(ks, c_sec))],
+                       disk_elements=[ot.Disk(i, I, c=c) for i, (I, c) in enumerate(zip(inertias, c_rot))])
+    lam, _ = peer.undamped_modal_analysis()
+    peer_hz = np.sort(np.sqrt(np.abs(lam.real)))[1:] / (2 * math.pi)
+    my_hz, _ = mine.natural_frequencies()
+    oracle(stage="torsion", quantity="seed 004 train natural frequencies vs openTorsion",
+           reference="peer code openTorsion Assembly.undamped_modal_analysis", tolerance="1e-6 rel",
+           measured=float(np.max(np.abs(my_hz / peer_hz - 1))), expected=0.0)
+    np.testing.assert_allclose(my_hz, peer_hz, rtol=1e-6)
+
+    rpm = 1494.6
+    res = steady_state(mine, f["excitation"], [rpm])
+    Om = rpm * math.pi / 30
+    F = f["excitation"].at([Om])[0]  # (orders, rotors)
+    omegas = f["excitation"].orders * Om
+    exc = ot.PeriodicExcitation(len(inertias), omegas)
+    for r in range(len(inertias)):
+        exc.add_sines(r, omegas, np.abs(F[:, r]), np.angle(F[:, r]))
+    q, _ = peer.ss_response(exc.excitation_matrix(), omegas, C=peer.C)
+    T_peer, _ = peer.vibratory_torque(exc, C=peer.C)
+    np.testing.assert_allclose(res.angle[0].T, q, rtol=1e-6, atol=1e-9 * np.abs(q).max())
+    np.testing.assert_allclose(np.abs(res.section_torque[0].T), np.abs(T_peer), rtol=1e-6,
+                               atol=1e-9 * np.abs(T_peer).max())
+    # synthesis of the peer's orders by dense sampling over the cycle (no Newton refinement)
+    k = np.rint(f["excitation"].orders * f["excitation"].cycle_revolutions).astype(int)
+    phi = np.linspace(0, 2 * math.pi, 200_001)
+    wave = np.exp(1j * np.outer(k, phi))
+    th = (q[:, :, None] * wave[None]).real.sum(axis=1)
+    tq = (T_peer[:, :, None] * wave[None]).real.sum(axis=1)
+    half_th = 0.5 * (th.max(axis=1) - th.min(axis=1))
+    half_tq = 0.5 * (tq.max(axis=1) - tq.min(axis=1))
+    err = np.max(np.abs(res.section_torque_nm[0] - half_tq)) / half_tq.max()
+    oracle(stage="torsion", quantity="seed 004 train synthesised section torque vs openTorsion orders",
+           reference="peer code openTorsion ss_response/vibratory_torque, synthesised by dense sampling",
+           tolerance="1e-4 of peak", measured=float(err), expected=0.0)
+    np.testing.assert_allclose(res.amplitude_rad[0], half_th, atol=1e-4 * half_th.max())
+    assert err <= 1e-4
+
+
+def test_seed004_train_study_writes_contract_fields_and_figures(tmp_path):
+    p = run_cli("run", SEED, "--out", tmp_path)
+    assert p.returncode == 0, p.stderr
+    t = json.loads((tmp_path / "results.json").read_text())["torsion"]
+    f = t["forced"]
+    n_s = len(f["speed_rpm"])
+    assert f["speed_rpm"][0] == 300.0 and f["speed_rpm"][-1] == pytest.approx(1800.0)
+    assert np.shape(f["amplitude_rad"]) == (n_s, 4)
+    assert np.shape(f["section_torque_nm"]) == (n_s, 3)
+    assert np.shape(f["section_stress_pa"]) == (n_s, 3)
+    # stress = K_t T / Z_p per section (closed form of a round section)
+    z = math.pi * 0.110**3 / 16
+    np.testing.assert_allclose(np.asarray(f["section_stress_pa"])[:, 0],
+                               1.6 * np.asarray(f["section_torque_nm"])[:, 0] / z, rtol=1e-12)
+    # the mean power of the two cylinders is the mechanism stage's mean crank torque x omega
+    mech = json.loads((tmp_path / "results.json").read_text())["mechanism"]
+    assert sum(f["excitation"]["mean_torque_nm"]) == pytest.approx(mech["mean_crank_torque_nm"], rel=1e-9)
+    assert f["stress_check"]["passes"] in (True, False) and "worst section" in f["summary"]
+    for name in ("torsion_forced_interference.png", "torsion_forced_response.png",
+                 "torsion_forced_stress.png", "torsion_forced_resonances.txt"):
+        assert (tmp_path / name).stat().st_size > 0
+
+
+@pytest.mark.parametrize("override, key", [
+    ("torsion.forced.firing_order=[1, 1]", "torsion.forced.firing_order"),
+    ("torsion.forced.throw_rotors=[1, 2, 3]", "torsion.forced.throw_rotors"),
+    ("torsion.forced.cylinder_throws=[1]", "torsion.forced.cylinder_throws"),
+    ("torsion.forced.pressure_table={angle_deg=[0.0, 200.0, 100.0, 360.0], pressure_pa=[1e5, 3e5, 2e5, 1e5], cycle_deg=360.0}",
+     "torsion.forced.pressure_table.angle_deg"),
+    ("torsion.forced.pressure_table={angle_deg=[0.0, 100.0, 300.0], pressure_pa=[1e5, 3e5, 1e5], cycle_deg=360.0}",
+     "torsion.forced.pressure_table.angle_deg"),
+    ("torsion.forced.pressure_table={angle_deg=[0.0, 100.0, 360.0], pressure_pa=[1e5, 3e5, 2e5], cycle_deg=360.0}",
+     "torsion.forced.pressure_table.pressure_pa"),
+    ("torsion.forced.modal_damping=-0.01", "torsion.forced.modal_damping"),
+    ("torsion.forced.section_damping=[0.0, -1.0, 6.0]", "torsion.forced.section_damping"),
+    ("torsion.forced.rotor_damping=[0.0, 1.0]", "torsion.forced.rotor_damping"),
+    ("torsion.forced.sections=[{diameter=0.1, bore=0.1}, {diameter=0.1}, {diameter=0.1}]",
+     "torsion.forced.sections[0].bore"),
+    ("torsion.forced.operating_speeds_rpm=[1900.0]", "torsion.forced.operating_speeds_rpm[0]"),
+    ("torsion.forced.speed_band=0.5", "torsion.forced.speed_band"),
+])
+def test_bad_forced_input_exits_2_with_one_line_naming_the_key(tmp_path, override, key):
+    p = run_cli("run", SEED, "--out", tmp_path, "--set", override)
+    assert p.returncode == 2, p.stderr
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and key in lines[0], p.stderr
+    assert "Traceback" not in p.stderr
+    assert not (tmp_path / "results.json").exists()
