@@ -3,8 +3,8 @@
 Every ready scene is read, every key of its sections (nested tables, arrays of tables, the machine
 defaults a ``machine = ...`` section pulls in, a geometry part's machine table) is mutated alone
 with ``--set`` (wrong type, 0, negative, nan/inf, huge, tiny, empty or wrong-length list, an
-unknown sibling key), and the CLI must answer as the README promises: exit 0, or exit 2 with one
-line ``crankmodal: error: ...`` naming the key, never a traceback. On the cheap scenes (mechanism
+unknown sibling key), and the CLI must answer as docs/guide/scenes.md says: exit 0, or exit 2
+with one line ``crankmodal: error: ...`` naming the key, never a traceback. On the cheap scenes (mechanism
 and torsion only, no gmsh) a sample of the mutations that pass ``check`` is also run: exit 0, 2 or
 3, one error line, and ``results.json`` complete and finite, or absent.
 

@@ -300,7 +300,7 @@ def test_the_fe_memory_bounds_the_mesh_size(tmp_path, monkeypatch):
 
 
 def test_fe_element_limit_against_the_measured_factor_memory():
-    """README: 2.78 GB at 303k P2 DOF, 12.9 GB at 831k (seed 004)."""
+    """docs/guide/fem.md: the factor takes 2.78 GB at 303k P2 DOF, 12.9 GB at 831k (seed 004)."""
     from crankmodal.geometry.mesh import DOF_PER_ELEMENT, fe_element_limit
 
     for gb, dof in ((2.78, 303e3), (12.9, 831e3)):

@@ -254,7 +254,7 @@ print(out)
 
 
 def test_two_concurrent_processes_give_bit_identical_modes_for_the_same_mesh():
-    """The README's claim: bit for bit for the same mesh and thread count, PARDISO on every
+    """docs/guide/fem.md's claim: bit for bit for the same mesh and thread count, PARDISO on every
     core and the row-block products included (two processes compete for the 2 cores)."""
     procs = [subprocess.Popen([sys.executable, "-c", _REPEAT], stdout=subprocess.PIPE, text=True)
              for _ in range(2)]
