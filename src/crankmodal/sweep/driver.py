@@ -26,7 +26,7 @@ from ..errors import CrankmodalError
 from ..results import make_out_dir, write_json_atomic
 from .execute import build_scene, execute_point, overrides_of, point_key
 from .spec import SweepSpec, check_max_failed, load_sweep
-from .store import RecordStore, folder_lock
+from .store import RecordStore, as_stored, folder_lock
 from .table import missing_outputs, refresh_outputs, suggestion, summarise, write_csv
 
 #: The workers' environment: one BLAS/OpenMP thread per worker process.
@@ -197,11 +197,9 @@ def dask_client(client=None, scheduler: str | None = None, workers: int | None =
             c.close()
         return
     n = workers or os.cpu_count() or 1
-    try:
-        import bokeh  # noqa: F401  (the dashboard needs it)
-        dashboard = ":0"
-    except ImportError:
-        dashboard = None
+    # a free port: the scheduler's HTTP server runs with or without bokeh, and on the default
+    # 8787 a second cluster on the machine warned "Port 8787 is already in use" (5 lines)
+    dashboard = ":0"
     import dask
 
     cluster = None
@@ -254,6 +252,7 @@ def run_tasks(client, tasks: list[dict], store: RecordStore, done: dict, log=Non
     """
     from ..progress import bar
 
+    _drop_mismatched(done, tasks, store, log)
     todo = list({t["key"]: t for t in tasks if t["key"] not in done}.values())  # a key once
     skipped = sum(t["key"] in done for t in tasks)
     if not todo:
@@ -318,6 +317,7 @@ def run_tasks_in_process(tasks: list[dict], store: RecordStore, done: dict, log=
     from ..progress import bar
     from .execute import execute_point
 
+    _drop_mismatched(done, tasks, store, log)
     todo = list({t["key"]: t for t in tasks if t["key"] not in done}.values())  # a key once
     skipped = sum(t["key"] in done for t in tasks)
     failed = 0
@@ -447,15 +447,10 @@ def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, 
     store = RecordStore(out_dir.resolve() / "records.jsonl")  # point dirs are absolute
     done = store.read()
     if store.skipped:
-        if log:
-            log(f"warning: {store.skipped_line()}")
-        else:
-            import warnings
-
-            warnings.warn(store.skipped_line(), UserWarning, stacklevel=3)
+        _warn(store.skipped_line(), log)
     if retry_failed:
         done = {k: r for k, r in done.items() if r.get("status") == "ok"}
-    before = set(done)  # recorded by earlier runs: "already recorded", not "run now"
+    before = dict(done)  # recorded by earlier runs: "already recorded", not "run now"
     stats = {"ran": 0, "skipped": 0, "failed": 0}
     rounds = []
     keys = [t["key"] for t in tasks]
@@ -499,7 +494,8 @@ def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, 
         "set": spec.fixed, "outputs": spec.outputs, "timeout_s": spec.timeout_s,
         "n_points": len(records), "status_counts": by_status,
         "n_ok": by_status.get("ok", 0), "n_failed": len(records) - by_status.get("ok", 0),
-        "ran": stats["ran"], "skipped": sum(k in before for k in dict.fromkeys(keys)),
+        "ran": stats["ran"],
+        "skipped": sum(k in before and done[k] is before[k] for k in dict.fromkeys(keys)),
         "failures": fails,
         "wall_time_s": time.perf_counter() - t0, "dask": info,
         "files": {"records": "records.jsonl", "table": "sweep.csv", "points": "points/"},
@@ -516,6 +512,30 @@ def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, 
             spec.search["sense"] if spec.search else "max")
     write_json_atomic(out_dir / "sweep.json", summary)
     return summary
+
+
+def _drop_mismatched(done: dict, tasks: list[dict], store: RecordStore, log=None) -> None:
+    """Remove from ``done`` the records of these tasks' keys whose ``parameters`` are not the
+    task's, with one warning line: a hand-edited file (a genuine record's key is the hash of its
+    parameters). The search refines around a record's parameters, so they must be the point's;
+    the points run again."""
+    bad = list(dict.fromkeys(t["key"] for t in tasks if t["key"] in done
+                             and done[t["key"]]["parameters"] != as_stored(t["parameters"])))
+    for k in bad:
+        del done[k]
+    if bad:
+        _warn(f"{store.path}: {len(bad)} record(s) whose parameters are not their point's "
+              "skipped; their points run again", log)
+
+
+def _warn(text: str, log=None) -> None:
+    """A warning line through ``log`` (the CLI's stderr), else a :class:`UserWarning`."""
+    if log:
+        log(f"warning: {text}")
+    else:
+        import warnings
+
+        warnings.warn(text, UserWarning, stacklevel=3)
 
 
 def _add(total: dict, part: dict) -> None:

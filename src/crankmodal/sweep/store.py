@@ -33,6 +33,11 @@ def _finite(obj):
     return obj
 
 
+def as_stored(obj):
+    """``obj`` as a record line gives it back (tuples as lists, NaN/inf as None)."""
+    return json.loads(json.dumps(_finite(obj)))
+
+
 #: The statuses a record may have.
 STATUSES = ("ok", "error", "timeout")
 

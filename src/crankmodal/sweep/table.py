@@ -39,7 +39,9 @@ def refresh_outputs(record: dict, outputs: list[str], root: Path) -> dict:
     path = root / record["dir"] / "results.json"
     try:
         results = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):  # untrusted: unreadable, not UTF-8 or JSON
+        return record
+    if not isinstance(results, dict):
         return record
     return {**record, "outputs": collect(results, outputs)}
 
@@ -66,7 +68,7 @@ def suggestion(record: dict, root: Path, path: str) -> str:
     """'; nearest: a.b.c' from a successful point's results.json, or ''."""
     try:
         results = json.loads((root / record["dir"] / "results.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError, KeyError):
+    except (OSError, ValueError, KeyError, RecursionError):
         return ""
     close = difflib.get_close_matches(path, flat_paths(results), n=2, cutoff=0.6)
     return f"; nearest: {', '.join(close)}" if close else ""
