@@ -13,9 +13,18 @@ Backends
     itself MKL ran PARDISO on one thread on a 2-core machine (factorisation 12 s instead of
     6 s at 169k DOF).
 ``superlu``
-    scipy's SuperLU, always available; a general LU, several times slower and hungrier.
+    scipy's SuperLU, always available; the last resort. A symmetric positive-definite matrix is
+    factorised in SuperLU's symmetric mode (minimum-degree ordering of A + Aᵀ, diagonal pivots):
+    at 85k DOF of the seed 000 crank 17.5 CPU-s against 33.4 with the general COLAMD ordering,
+    and PARDISO's 1.8 (one thread each; benchmarks/factorisation_bench.py).
 ``auto``
-    ``pardiso`` when importable, else ``superlu``.
+    ``pardiso`` when importable, else ``superlu`` with one :class:`~crankmodal.errors.ModelWarning`
+    line saying so and what it costs.
+
+Evaluated and not used (benchmarks/README.md, "Factorisation backends"): ``python-mumps`` ships
+no wheels (its sdist needs a MUMPS library installed by other means), and ``cholespy``'s wheels
+(Linux x86-64, macOS, Windows; none for Linux aarch64) factorise the 85k-DOF crank in 29.5 CPU-s,
+16x PARDISO and slower than SuperLU's symmetric mode.
 """
 
 from __future__ import annotations
@@ -87,11 +96,28 @@ def resolve_backend(backend: str) -> str:
         raise ParameterError("backend", f"must be one of {', '.join(BACKENDS)}; got {backend!r}")
     have = available_backends()
     if backend == "auto":
+        if have[0] == "superlu":
+            _warn_superlu_fallback()
         return have[0]
     if backend not in have:
         raise ParameterError("backend", f"{backend!r} is not installed (pip install pypardiso); "
                                         f"available: {', '.join(have)}")
     return backend
+
+
+#: SuperLU's cost against PARDISO on the seed 000 crank (CPU seconds of one factorisation, one
+#: thread each, symmetric mode): 85k DOF 17.5 / 1.8 s
+SUPERLU_SLOWDOWN = 10
+
+
+@functools.cache
+def _warn_superlu_fallback() -> None:
+    """Say once per process that ``auto`` fell back to SuperLU, and what that costs."""
+    from ..errors import warn
+
+    warn(f"fem: PARDISO (pypardiso, Intel MKL) is not installed here, so sparse factorisations "
+         f"use scipy's SuperLU: about {SUPERLU_SLOWDOWN}x slower and hungrier on a crankshaft "
+         f"mesh (pip install pypardiso where MKL has wheels: x86-64 Linux, Windows, macOS)")
 
 
 class SuperLUFactor:
@@ -106,15 +132,20 @@ class SuperLUFactor:
 
     name = "superlu"
 
-    def __init__(self, A, label: str = ""):
+    def __init__(self, A, label: str = "", positive_definite: bool = False):
         from scipy.sparse.linalg import splu
 
         from .memory import address_space_limit, available_bytes
 
         n, avail = A.shape[0], available_bytes()
+        # symmetric positive definite: minimum degree on A + A^T and diagonal pivots (SuperLU's
+        # symmetric mode), half the time of the general COLAMD ordering on a crank mesh
+        kw = (dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                   options=dict(SymmetricMode=True)) if positive_definite
+              else dict(permc_spec="COLAMD"))
         try:
             with address_space_limit(avail):
-                self._lu = splu(sp.csc_matrix(A), permc_spec="COLAMD")
+                self._lu = splu(sp.csc_matrix(A), **kw)
         except MemoryError:
             room = "memory" if avail is None else f"the {avail / 1e9:.3g} GB available"
             raise ResourceError(
@@ -278,7 +309,7 @@ def factorize(A, backend: str = "auto", positive_definite: bool = True, label: s
     name = resolve_backend(backend)
     if name == "pardiso":
         return PardisoFactor(A, positive_definite=positive_definite, label=label)
-    return SuperLUFactor(A, label=label)
+    return SuperLUFactor(A, label=label, positive_definite=positive_definite)
 
 
 def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_definite: bool = True,
@@ -300,7 +331,7 @@ def factorize_shifted(K, M, sigma: float, backend: str = "auto", positive_defini
             U -= sigma * upper_triangle(M)
         return PardisoFactor(U.tocsr(), positive_definite=positive_definite, upper=True,
                              label=label)
-    return SuperLUFactor(K - sigma * M, label=label)
+    return SuperLUFactor(K - sigma * M, label=label, positive_definite=positive_definite)
 
 
 def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
@@ -321,4 +352,5 @@ def factorize_submatrix(K, idx: np.ndarray, backend: str = "auto",
     if resolve_backend(backend) == "pardiso":
         U = upper_triangle(K)[idx][:, idx]
         return PardisoFactor(U, positive_definite=positive_definite, upper=True, label=label)
-    return SuperLUFactor(sp.csr_matrix(K)[idx][:, idx], label=label)
+    return SuperLUFactor(sp.csr_matrix(K)[idx][:, idx], label=label,
+                         positive_definite=positive_definite)
