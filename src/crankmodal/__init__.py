@@ -95,6 +95,7 @@ _EXPORTS: dict[str, tuple[str, str]] = {
     "load_flexible_body": ("crankmodal.dynamics.flexible", "load_flexible_body"),
     "crank_body": ("crankmodal.dynamics.flexbuild", "crank_body"),
     "rod_body": ("crankmodal.dynamics.flexbuild", "rod_body"),
+    "link_body": ("crankmodal.dynamics.flexbuild", "link_body"),
     "rigid_twin": ("crankmodal.dynamics.flexbuild", "rigid_twin"),
     "Revolute": ("crankmodal.dynamics.joints", "Revolute"),
     "Prismatic": ("crankmodal.dynamics.joints", "Prismatic"),
@@ -112,6 +113,7 @@ _EXPORTS: dict[str, tuple[str, str]] = {
     "integrate": ("crankmodal.dynamics.simulate", "integrate"),
     "History": ("crankmodal.dynamics.history", "History"),
     "simulate": ("crankmodal.dynamics.analysis", "simulate"),
+    "quasi_static_start": ("crankmodal.dynamics.initial", "quasi_static_start"),
 }
 
 # the same names as _EXPORTS (a literal list, for static tools); tests/test_api.py checks it
@@ -173,6 +175,7 @@ __all__ = [
     "import_cad",
     "import_mesh",
     "integrate",
+    "link_body",
     "list_machines",
     "load_flexbody",
     "load_flexible_body",
@@ -185,6 +188,7 @@ __all__ = [
     "material",
     "params_from_dict",
     "pressure_load",
+    "quasi_static_start",
     "reduce_body",
     "reduce_to_two_rotors",
     "remote_force",

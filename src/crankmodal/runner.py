@@ -85,8 +85,23 @@ def plan(scene: Scene) -> list[str]:
     return order
 
 
+def _check_scene(scene) -> Scene:
+    from .arguments import instance
+
+    return instance("scene", scene, Scene, "a Scene (load_scene, scene_from_dict, scene_path)")
+
+
 def check(scene: Scene) -> dict[str, dict]:
-    """Validate every section without running anything; returns the parameters per section."""
+    """Validate every section without running anything; returns the parameters per section.
+
+    Raises
+    ------
+    ParameterError
+        ``scene`` is not a :class:`~crankmodal.scene.Scene`.
+    SceneError
+        A scene key is unknown, of the wrong type, or out of its range.
+    """
+    _check_scene(scene)
     return {s: stage_module(s).validate(scene.sections[s], scene) for s in plan(scene)}
 
 
@@ -113,10 +128,22 @@ def run(scene: Scene, out_dir: str | Path, figures: bool = True, log=None) -> di
 
     Raises
     ------
+    ParameterError
+        ``scene`` is not a Scene, ``out_dir`` not a path, ``figures`` not a bool or ``log`` not
+        callable (before anything runs).
     OutputError
         If the folder or a file in it cannot be written (a file in the way, read-only, disk
         full); no results.json is left.
     """
+    from .arguments import instance, path
+
+    _check_scene(scene)
+    path("out_dir", out_dir)
+    instance("figures", figures, bool, "True or False")
+    if log is not None and not callable(log):
+        from .errors import ParameterError
+
+        raise ParameterError("log", f"must be None or a function of one str, got {log!r:.60}")
     params = check(scene)
     out_dir = make_out_dir(out_dir)
     try:

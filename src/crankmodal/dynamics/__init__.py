@@ -8,13 +8,17 @@ constraints), ``simulate`` (integration with contact events), ``history`` (sampl
 energy balance), ``signals`` (spectra, impacts, contact loss), ``mechanisms`` (slider-crank
 trains, four-star, four-bar), ``analysis`` (checked runs, tolerance study), ``scene_keys``,
 ``build``, ``bridge`` (machines of :mod:`crankmodal.mechanism`), ``plots``, ``stage``,
-``flexible`` (planar floating-frame body from a reduced ``.npz``; core only, not in scenes yet).
+``flexible`` (planar floating-frame body from a reduced ``.npz``), ``flexbuild`` (crank, rod and
+four-bar link bodies from reduced files), ``initial`` (the quasi-static start of flexible bodies).
 """
 
 from .analysis import simulate, tolerance_study
+from .flexbuild import crank_body, link_body, rod_body
 from .flexible import FlexibleBody, load_flexible_body
+from .initial import quasi_static_start
 from .mechanisms import Cylinder, Mechanism, crank_train, four_bar
-from .simulate import SolverSettings
+from .simulate import SolverSettings, auto_method
 
-__all__ = ["Cylinder", "FlexibleBody", "Mechanism", "SolverSettings", "crank_train", "four_bar",
-           "load_flexible_body", "simulate", "tolerance_study"]
+__all__ = ["Cylinder", "FlexibleBody", "Mechanism", "SolverSettings", "auto_method",
+           "crank_body", "crank_train", "four_bar", "link_body", "load_flexible_body",
+           "quasi_static_start", "rod_body", "simulate", "tolerance_study"]

@@ -20,30 +20,126 @@ def output_times(t_end: float, output_step: float) -> np.ndarray:
     return np.linspace(0.0, k * output_step, k + 1)
 
 
+#: floats held per output sample, per coordinate of the integrator's state (``2 n + N_AUX``):
+#: the solver's output and its concatenated copy (2), and the history recorded from it, which
+#: measured 1.3-1.7 per state coordinate (32-41 floats against 24-36 for a slider-crank, a
+#: two-cylinder train and a clearance joint), bounded here by 2
+FLOATS_PER_STATE_SAMPLE = 4
+
+
+def check_output(sysm, t_end: float, output_step: float) -> int:
+    """Refuse a run whose output samples would not fit: more than the scene limit
+    (:data:`~.scene_keys.MAX_OUTPUT_SAMPLES`) or more memory than the machine has.
+
+    Returns
+    -------
+    int
+        The number of output samples.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``output_step``, with the samples, the memory estimate and the smallest step
+        that fits.
+    """
+    from ..errors import ParameterError
+    from ..fem.memory import available_bytes
+    from .scene_keys import MAX_OUTPUT_SAMPLES
+    from .system import N_AUX
+
+    samples = t_end / output_step + 1.0
+    per_sample = 8.0 * FLOATS_PER_STATE_SAMPLE * (2 * sysm.n + N_AUX)
+    avail = available_bytes()
+    limit = float(MAX_OUTPUT_SAMPLES)
+    reason = f"crankmodal's limit of {MAX_OUTPUT_SAMPLES:.0e} samples"
+    if avail and 0.5 * avail / per_sample < limit:
+        limit, reason = 0.5 * avail / per_sample, f"half the {avail / 1e9:.3g} GB available"
+    if samples > limit:
+        raise ParameterError("output_step", f"{output_step:g} s makes {samples:.3g} output "
+                             f"samples of {t_end:g} s (about {samples * per_sample / 1e9:.3g} "
+                             f"GB at {per_sample:.0f} bytes each), over {reason}; use "
+                             f"output_step >= {t_end / (limit - 1.0):.3g} s")
+    return round(samples)
+
+
+def _check_run(mech, t_end, output_step, settings, energy_tolerance, start):
+    """The arguments of :func:`simulate`, by the ``[dynamics]`` keys' rules."""
+    from .. import arguments as arg
+    from .mechanisms import Mechanism
+    from .scene_keys import FLEXIBLE, SCHEMA
+
+    arg.instance("mech", mech, Mechanism, "a Mechanism (crank_train, four_bar)")
+    t_end = arg.check("t_end", t_end, SCHEMA["end_time"])
+    output_step = arg.check("output_step", output_step, SCHEMA["output_step"])
+    if output_step > t_end:
+        from ..errors import ParameterError
+
+        raise ParameterError("output_step", f"must be <= t_end ({t_end:g} s), got "
+                             f"{output_step:g}")
+    if settings is not None:
+        arg.instance("settings", settings, SolverSettings, "a SolverSettings or None")
+    energy_tolerance = arg.check("energy_tolerance", energy_tolerance,
+                                 SCHEMA["energy_tolerance"], optional=True)
+    arg.check("start", start, FLEXIBLE["start"], optional=True)  # dynamics.flexible.start
+    return t_end, output_step, energy_tolerance
+
+
+def resolved(settings: SolverSettings | None, mech) -> SolverSettings:
+    """``settings`` (default :class:`SolverSettings`) with ``method = "auto"`` decided for
+    ``mech`` (:func:`~.simulate.auto_method`, as a scene decides it)."""
+    from .simulate import system_method
+
+    settings = settings or SolverSettings()
+    if settings.method != "auto":
+        return settings
+    return replace(settings, method=system_method(mech.system, 2.0 * np.pi * mech.revolution_hz))
+
+
 def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, ideal=False,
-             energy_tolerance: float | None = 1e-3) -> History:
+             energy_tolerance: float | None = 1e-3, start: str | None = None) -> History:
     """Integrate a mechanism and sample its history.
 
     Parameters
     ----------
     mech : Mechanism
-    t_end, output_step : float
-        s.
+    t_end : float
+        Simulated time, s (``0 < t_end <= 100``, as ``dynamics.end_time``).
+    output_step : float
+        Output sampling step, s (``<= t_end``; refused when its samples would not fit in
+        memory, :func:`check_output`).
     settings : SolverSettings, optional
+        Default ``SolverSettings()``; its ``method = "auto"`` is decided for this mechanism as
+        a scene decides it (:func:`~.simulate.auto_method`).
     ideal : bool
         Run the ideal-joint twin instead of the clearance model.
     energy_tolerance : float or None
         Largest admissible energy-balance residual relative to the energy exchanged in the run
-        (:meth:`History.energy_scale`).
+        (:meth:`History.energy_scale`), > 0; None: not checked.
+    start : {"quasi_static", "undeformed"} or None
+        Initial elastic state of flexible bodies (None: ``mech.start``, by default
+        ``"quasi_static"``, as scenes start). ``quasi_static``: unless done already, the
+        bodies are first deformed to rest under the loads at ``t = 0``
+        (:meth:`~.mechanisms.Mechanism.start_quasi_static`, which replaces ``mech.q0`` and
+        ``mech.qd0`` and records ``mech.start_info``), so a run at full speed does not begin
+        with a start-up blow; ``undeformed``: ``mech.q0`` as it is (as built: undeformed).
+        No effect on bodies without elastic modes.
 
     Raises
     ------
+    ParameterError
+        An argument out of its range, naming it (``output_step: 1e-12 s makes 1e+10 output
+        samples ...``).
     NumericalError
         Solver failure, or an energy balance that does not close, or a penetration so deep the
         contact law is meaningless (the message names the parameter to change).
     """
-    settings = settings or SolverSettings()
+    t_end, output_step, energy_tolerance = _check_run(mech, t_end, output_step, settings,
+                                                      energy_tolerance, start)
     sysm = mech.ideal if ideal else mech.system
+    check_output(sysm, t_end, output_step)
+    settings = resolved(settings, mech)
+    if (start or mech.start) == "quasi_static" and mech.start_info is None:
+        mech.start_quasi_static()
     for cj in sysm.clearances:
         cj.v_impact = cj.v_impact_min
     integ = integrate(sysm, mech.q0, mech.qd0, t_end, output_times(t_end, output_step), settings)

@@ -9,7 +9,7 @@ from . import contact
 from .loads import tabulated_gas_force
 from .mechanisms import Cylinder, crank_train, four_bar
 from .scene_keys import cylinder_angles
-from .simulate import SolverSettings
+from .simulate import SolverSettings, auto_method
 
 
 def contact_arguments(p) -> tuple[dict, dict]:
@@ -136,33 +136,11 @@ def solver_settings(p, speed_rpm, flexible: bool = False) -> SolverSettings:
     atol = s["atol"] if s["atol"] is not None else min(1e-9, cmin * 1e-4)
     omega = speed_rpm * 2 * np.pi / 60
     method = s["method"]
-    if method == "auto":
-        method = "RK45"
+    if method == "auto":  # the API's simulate decides with the same function
         fr = p["friction"]
-        r_max = max((c["journal_radius"] for c in p["clearances"]), default=0.0)
-        # near stiction the friction law's slope mu_s / v_s makes the problem stiff when the
-        # journal slides slowly at the working speed (a brief start-up ramp is cheaper in RK45:
-        # measured 10 k against 51 k evaluations for the four-star's 0.1 s ramp)
-        slow = r_max * omega < 10.0 * fr["v_dynamic"]
-        if fr["law"] != "none" and p["clearances"] and slow:
-            method = "LSODA"
-        # an oil film is stiff near the wall ((1 - eps^2)^-5/2): measured 0.8 s LSODA, minutes RK45
-        lubricated = any(c["viscosity"] is not None for c in p["clearances"])
-        if lubricated:
-            method = "LSODA"
-        # flexible bodies on ideal joints: their stiffest modes (kHz) bound an explicit step by
-        # stability, which A-stable Radau IIA steps over. Measured (benchmarks/README.md):
-        # slider-crank, crank 20 + rod 14 modes to 22.6 kHz, 0.1 s: Radau 19 k evaluations,
-        # 0.10 simulated s per wall s, against RK45 59 k, 0.038, and Radau nearer a tight
-        # reference (4e-4 against 2e-3 of the peak). With impacts RK45 stays: four-star with a
-        # flexible crank and rods and one clearance, 0.3 s: RK45 64 k evaluations in 4.9 s,
-        # Radau 236 k in 128 s (every contact onset restarts it with a new Jacobian).
-        # with an oil film too (measured: the loom's coupler with the seed's lubricated C
-        # joint, LSODA stalled at 0.17 of 0.4 s after 2 M evaluations, Radau ran it in 95 k;
-        # the four-star with a lubricated big end and flexible rods, Radau 2.5 k evaluations in
-        # 2.2 s against LSODA's 9.1 k in 6.6 s)
-        if flexible and (not p["clearances"] or lubricated):
-            method = "Radau"
+        method = auto_method([(c["journal_radius"], fr["law"], fr["v_dynamic"],
+                               c["viscosity"] is not None) for c in p["clearances"]],
+                             omega, flexible)
     return SolverSettings(method=method, rtol=s["rtol"], atol=atol,
                           velocity_scale=max(1000.0, 10 * omega),
                           max_step=np.deg2rad(s["max_step_deg"]) / omega,

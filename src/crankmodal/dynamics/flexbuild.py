@@ -156,7 +156,54 @@ def _centres(fb) -> dict:
     return {n: np.asarray(c, float) for n, c in zip(fb.interface_names, fb.interface_centres)}
 
 
-def crank_body(source, spec: dict, row_z, crank_radius: float | None, name: str = "crank"):
+def body_spec(spec, link: bool = False) -> dict:
+    """A builder's ``spec`` checked by the ``[dynamics.flexible.<body>]`` keys' rules, with
+    their defaults filled in (``damping_ratio`` 0.02, every stored in-plane mode).
+
+    Parameters
+    ----------
+    spec : dict or None
+        Any of the table's keys (:data:`~.scene_keys.FLEX_BODY`; a four-bar link's,
+        :data:`~.scene_keys.LINK_BODY`, with ``link``); None is ``{}``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``spec.<key>``: an unknown key, a value out of its range, or both ``n_modes`` and
+        ``cutoff_hz``.
+    """
+    from .. import arguments as arg
+    from .scene_keys import FLEX_BODY, LINK_BODY
+
+    schema = LINK_BODY if link else FLEX_BODY
+    out = arg.table("spec", spec, schema)
+    for key, rule in schema.items():
+        if key in out and key in ("n_modes", "cutoff_hz", "damping_ratio", "interfaces"):
+            out[key] = arg.check(f"spec.{key}", out[key], rule, optional=True)
+        out.setdefault(key, rule.default)
+    if out["damping_ratio"] is None:
+        out["damping_ratio"] = schema["damping_ratio"].default
+    if out["n_modes"] is not None and out["cutoff_hz"] is not None:
+        raise ParameterError("spec.cutoff_hz", "give either n_modes or cutoff_hz, not both")
+    return out
+
+
+def _source(source):
+    """``source`` of a builder: a flexbody file path or a reduced body read already."""
+    if not isinstance(source, (str, os.PathLike)) and not hasattr(source, "interface_names"):
+        raise ParameterError("source", "must be a crankmodal-flexbody .npz path or a reduced "
+                             f"body (load_flexbody, reduce_body), got {source!r:.60}")
+    return source
+
+
+def _rows(row_z) -> list[float]:
+    from .. import arguments as arg
+
+    return arg.numbers("row_z", [0.0] if row_z is None else row_z)
+
+
+def crank_body(source, spec: dict | None = None, row_z=None, crank_radius: float | None = None,
+               name: str = "crank"):
     """A planar flexible crank from a flexbody file, frames named for a crank train.
 
     Parameters
@@ -164,10 +211,13 @@ def crank_body(source, spec: dict, row_z, crank_radius: float | None, name: str 
     source : str, Path or reduced body
         ``crankmodal-flexbody`` file of a crankshaft (interfaces ``main_journal_*``,
         ``crankpin_*`` bands, optionally ``flywheel_end_face``), or that body read already.
-    spec : dict
-        ``n_modes`` / ``cutoff_hz`` / ``damping_ratio``.
-    row_z : sequence of float
-        Axial position of each rod's row relative to the crankpin's middle, m.
+    spec : dict, optional
+        ``n_modes`` / ``cutoff_hz`` (default: every stored in-plane mode) and
+        ``damping_ratio`` (default 0.02), as the ``[dynamics.flexible.crank]`` keys
+        (:func:`body_spec`).
+    row_z : sequence of float, optional
+        Axial position of each rod's row relative to the crankpin's middle, m (default
+        ``[0.0]``: one rod in the middle).
     crank_radius : float or None
         The mechanism's crank radius, m, checked against the file (±1 %).
 
@@ -175,11 +225,22 @@ def crank_body(source, spec: dict, row_z, crank_radius: float | None, name: str 
     -------
     body : FlexibleBody
     roles : dict
-        ``mains`` (frame names), ``pins`` (one per rod), ``drive``.
+        ``mains`` (frame names), ``pins`` (one per rod), ``drive``; the default of
+        :func:`~.mechanisms.crank_train`'s ``crank_roles``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``spec.<key>``, ``row_z``, ``crank_radius`` or ``source`` (interfaces missing,
+        or the crank radius off).
     """
+    from .. import arguments as arg
     from .flexible import planar_body
 
-    fb, path = read(source)
+    spec = body_spec(spec)
+    row_z = _rows(row_z)
+    crank_radius = arg.number("crank_radius", crank_radius, gt=0.0, optional=True)
+    fb, path = read(_source(source))
     centres = _centres(fb)
     mains = sorted(n for n in centres if n.startswith("main_journal"))
     bands = sorted(n for n in centres if n.startswith("crankpin"))
@@ -215,14 +276,21 @@ def crank_body(source, spec: dict, row_z, crank_radius: float | None, name: str 
     return body, roles
 
 
-def rod_body(source, spec: dict, rod_length: float | None, name: str, z: float = 0.0):
+def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
+             name: str = "rod_1", z: float = 0.0):
     """A planar flexible rod from a flexbody file (or that body read already, ``source``) with
     ``big_end_bore`` and ``small_end_bore`` interfaces: frames ``big`` and ``small``, body x axis
     from the big to the small end; its length checked against the mechanism's ``rod_length``
-    (m, ±1 %)."""
+    (m, ±1 %). ``spec`` as for :func:`crank_body` (:func:`body_spec`: ``n_modes`` /
+    ``cutoff_hz``, ``damping_ratio`` default 0.02); ``z`` the rod's row, m. A bad argument
+    raises ParameterError naming it (``spec.damping_ratio``, ``rod_length``, ``source``)."""
+    from .. import arguments as arg
     from .flexible import planar_body
 
-    fb, path = read(source)
+    spec = body_spec(spec)
+    rod_length = arg.number("rod_length", rod_length, gt=0.0, optional=True)
+    z = arg.number("z", z)
+    fb, path = read(_source(source))
     c = _centres(fb)
     for bore in ("big_end_bore", "small_end_bore"):
         if bore not in c:
@@ -292,14 +360,16 @@ def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
     return path
 
 
-def link_body(source, spec: dict, length: float | None, role: str, name: str | None = None):
+def link_body(source, spec: dict | None = None, length: float | None = None,
+              role: str = "coupler", name: str | None = None):
     """A planar flexible four-bar link from a flexbody file (or that body read already).
 
     Parameters
     ----------
     source : str, Path or reduced body
-    spec : dict
-        ``n_modes`` / ``cutoff_hz`` / ``damping_ratio`` and ``interfaces``: the file's two
+    spec : dict, optional
+        ``n_modes`` / ``cutoff_hz`` / ``damping_ratio`` (defaults as for :func:`crank_body`,
+        :func:`body_spec`) and ``interfaces``: the file's two
         interfaces carrying the link's joints, in the order of
         :data:`~.mechanisms.FOUR_BAR_JOINTS` (crank A, B; coupler B, C; rocker D, C); None: the
         file's two interfaces in stored order (it must have exactly two).
@@ -315,10 +385,14 @@ def link_body(source, spec: dict, length: float | None, role: str, name: str | N
         Frames named for its joints (aliases of the interfaces), body x axis from the first
         joint to the second; ``info["roles"]`` maps joint to interface.
     """
+    from .. import arguments as arg
     from .flexible import planar_body
     from .mechanisms import FOUR_BAR_JOINTS
 
-    fb, path = read(source)
+    spec = body_spec(spec, link=True)
+    length = arg.number("length", length, gt=0.0, optional=True)
+    arg.one_of("role", role, tuple(FOUR_BAR_JOINTS))
+    fb, path = read(_source(source))
     c = _centres(fb)
     names = spec.get("interfaces")
     if names is None:

@@ -27,19 +27,45 @@ def _elastic_columns(sysm) -> np.ndarray:
 def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
     """Elastic coordinates at quasi-static rest at time ``t`` (see the module docstring).
 
+    What scenes do before a run with flexible bodies (``dynamics.flexible.start =
+    "quasi_static"``, the default) and :func:`~.analysis.simulate` does by default
+    (:meth:`~.mechanisms.Mechanism.start_quasi_static` calls it on the mechanism's ideal-joint
+    twin). Example, a mechanism ``mech`` with a flexible crank::
+
+        q, qd, info = quasi_static_start(mech.ideal, mech.q0, mech.qd0)
+        # info["residual"] < 1e-9: the elastic accelerations vanish at t = 0
+
     Parameters
     ----------
     sysm : Multibody
     q, qd : arrays
         A consistent state (e.g. the builder's, bodies undeformed).
+    t : float
+        Time of the state, s.
     tol : float
-        Stop when the elastic accelerations, scaled by the slowest mode's ω², are below this
-        (m kg^½ of modal coordinate).
+        Stop when the elastic accelerations, each divided by its mode's ω², are below this
+        (modal coordinate, m kg^½), > 0.
+    max_iter : int
+        Newton iterations at most, >= 1.
 
     Returns
     -------
-    q, qd, info : the state and ``{"iterations", "residual"}``.
+    q, qd, info : the state (elastic velocities zero, rigid coordinates re-assembled on the
+        joints) and ``{"iterations", "residual"}``; ``q`` and ``qd`` as given (copies) without
+        elastic modes.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``q``, ``qd`` (not ``sysm.n`` finite numbers), ``t``, ``tol`` or ``max_iter``.
     """
+    from .. import arguments as arg
+
+    q = np.asarray(arg.numbers("q", np.asarray(q, float).ravel(), length=sysm.n), float)
+    qd = np.asarray(arg.numbers("qd", np.asarray(qd, float).ravel(), length=sysm.n), float)
+    t = arg.number("t", t)
+    tol = arg.number("tol", tol, gt=0.0)
+    max_iter = arg.integer("max_iter", max_iter, ge=1)
     cols = _elastic_columns(sysm)
     if cols.size == 0:
         return q, qd, {"iterations": 0, "residual": 0.0}

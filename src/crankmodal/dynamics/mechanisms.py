@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ParameterError
 from .bodies import Ground, RigidBody
 from .clearance import ClearanceJoint
 from .joints import AngleDrive, Prismatic, Revolute, SpeedProfile
@@ -47,6 +48,25 @@ class Cylinder:
     gas_force: object = None
     ring_friction: float = 0.0
 
+    def __post_init__(self):
+        """Check every field by the ``[dynamics.crank_train]`` keys' rules (ParameterError
+        naming the field): lengths and masses > 0, ``rod_com >= 0``; ``rod_inertia >= 0``
+        (0 only with a rod body given to :func:`crank_train`, which brings its own inertia);
+        angles and offsets finite; ``gas_force`` None or callable; ``ring_friction >= 0``."""
+        from .. import arguments as arg
+        from .scene_keys import CRANK_TRAIN, SCHEMA
+
+        self.axis_angle = arg.number("axis_angle", self.axis_angle)
+        for name in ("rod_length", "rod_mass", "rod_com", "piston_mass", "offset"):
+            setattr(self, name, arg.check(name, getattr(self, name), CRANK_TRAIN[name]))
+        self.rod_inertia = arg.number("rod_inertia", self.rod_inertia, ge=0.0)
+        self.z = arg.number("z", self.z)
+        self.ring_friction = arg.check("ring_friction", self.ring_friction,
+                                       SCHEMA["ring_friction_n"])
+        if self.gas_force is not None and not callable(self.gas_force):
+            raise ParameterError("gas_force", "must be None or a function of the crank angle "
+                                 f"from top dead centre (rad) giving N, got {self.gas_force!r:.60}")
+
     @classmethod
     def from_machine(cls, machine, cylinder, gas_force=None,
                      ring_friction: float = 0.0) -> Cylinder:
@@ -74,8 +94,6 @@ class Cylinder:
             ``cylinder.throw_angle`` is not 0 (:func:`crank_train` puts every rod on one pin).
         """
         if abs(cylinder.throw_angle) > 0.0:
-            from ..errors import ParameterError
-
             raise ParameterError("cylinder.throw_angle", "cylinders on separate crank throws are "
                                  f"not supported yet (must be 0, got {cylinder.throw_angle})")
         rod = machine.rod
@@ -101,17 +119,34 @@ class Mechanism:
     main_joint: str = "main"
     rows_z: dict = field(default_factory=dict)
     main_joints: list = field(default_factory=list)
+    start: str = "quasi_static"
+    start_info: dict | None = None
 
     def __post_init__(self):
         if not self.main_joints:
             self.main_joints = [self.main_joint]
 
+    def start_quasi_static(self) -> dict:
+        """Deform the flexible bodies to rest under the loads at ``t = 0``, as scenes start.
 
-class RedundantJoints(ValueError):
-    """The joints hold more than the bodies' coordinates can give (a singular system)."""
+        Replaces ``q0`` and ``qd0`` by :func:`~.initial.quasi_static_start`'s state (solved on
+        the ideal-joint twin: across a clearance the Newton steps found spurious states balanced
+        by the contact or film force past the wall: the loom's coupler pin C at 165 % of its
+        clearance) and keeps its ``{"iterations", "residual"}`` in ``start_info``. :func:`~.analysis.simulate` calls it before the first
+        run unless told ``start="undeformed"``. Without elastic modes nothing changes.
+        """
+        from .initial import quasi_static_start
+
+        self.q0, self.qd0, self.start_info = quasi_static_start(self.ideal, self.q0, self.qd0)
+        return self.start_info
 
 
-def _check_rank(sysm, q, what: str) -> None:
+class RedundantJoints(ParameterError):
+    """The joints hold more than the bodies' coordinates can give (a singular system); a
+    :class:`~crankmodal.errors.ParameterError` naming the body argument that brought them."""
+
+
+def _check_rank(sysm, q, what: str, argument: str = "bodies") -> None:
     """Refuse redundant constraints at the assembled state (the KKT matrix would be singular)."""
     if not sysm.m:
         return
@@ -119,8 +154,8 @@ def _check_rank(sysm, q, what: str) -> None:
     sv = np.linalg.svd(Cq, compute_uv=False)
     rank = int(np.sum(sv > 1e-9 * sv[0]))
     if rank < sysm.m:
-        raise RedundantJoints(f"{what}: {sysm.m - rank} of its {sysm.m} joint equations are "
-                              f"redundant (rank {rank})")
+        raise RedundantJoints(argument, f"{what}: {sysm.m - rank} of its {sysm.m} joint "
+                              f"equations are redundant (rank {rank})")
 
 
 def _unit(angle):
@@ -129,30 +164,83 @@ def _unit(angle):
 
 def _split(pins, clearance_specs, contact_kw):
     """Ideal pins and clearance joints from the pin list and {name: spec}."""
+    from .. import arguments as arg
+
+    clearance_specs = arg.table("clearances", clearance_specs, {p.name for p in pins})
+    contact_kw = arg.table("contact_kw", contact_kw, CONTACT_KW)
     ideal_pins, clear = [], []
     for p in pins:
         spec = clearance_specs.get(p.name)
         if spec is None:
             ideal_pins.append(p)
             continue
+        spec = _clearance_spec(f"clearances.{p.name}", spec)
         kw = dict(contact_kw)
-        kw.update(spec.get("contact", {}))  # per-joint overrides (e.g. a stiffness from the radii)
-        clear.append(ClearanceJoint(
-            name=p.name, journal=p.a, journal_frame=p.frame_a, bearing=p.b, bearing_frame=p.frame_b,
-            clearance=spec["clearance"], journal_radius=spec["journal_radius"],
-            clearance_major=spec.get("clearance_major"), wear_angle=spec.get("wear_angle", 0.0),
-            viscosity=spec.get("viscosity"), bearing_length=spec.get("bearing_length", 0.0),
-            film_model=spec.get("film_model", "short"),
-            **kw))
-    unknown = set(clearance_specs) - {p.name for p in pins}
-    if unknown:
-        names = ", ".join(p.name for p in pins)
-        raise KeyError(f"no joint named {min(unknown)!r}; joints are: {names}")
+        kw.update(spec.get("contact") or {})  # per-joint overrides (a stiffness from the radii)
+        try:
+            clear.append(ClearanceJoint(
+                name=p.name, journal=p.a, journal_frame=p.frame_a, bearing=p.b,
+                bearing_frame=p.frame_b, clearance=spec["clearance"],
+                journal_radius=spec["journal_radius"], clearance_major=spec.get("clearance_major"),
+                wear_angle=spec.get("wear_angle", 0.0), viscosity=spec.get("viscosity"),
+                bearing_length=spec.get("bearing_length") or 0.0,
+                film_model=spec.get("film_model", "short"), **kw))
+        except ParameterError:
+            raise
+        except (ValueError, TypeError) as exc:  # the law objects' own checks
+            where = f"clearances.{p.name}.contact" if spec.get("contact") else "contact_kw"
+            raise ParameterError(where, f"joint {p.name!r}: {exc}"
+                                 + _stiffness_hint(kw, spec)) from None
     return ideal_pins, clear
 
 
+#: keys of ``contact_kw`` (the clearance joints' shared law settings)
+CONTACT_KW = ("law", "law_params", "friction", "friction_params", "v_impact_min")
+
+
+def _clearance_spec(name: str, spec) -> dict:
+    """One ``clearances`` entry checked by the ``[[dynamics.clearances]]`` keys' rules."""
+    from .. import arguments as arg
+    from .scene_keys import CLEARANCE
+
+    keys = ("clearance", "journal_radius", "clearance_major", "wear_angle", "viscosity",
+            "bearing_length", "film_model", "contact")
+    spec = arg.table(name, spec, keys, required=("clearance", "journal_radius"))
+    if spec.get("bearing_length") == 0.0:  # no film: the length is not used
+        spec["bearing_length"] = None
+    for key in ("clearance", "journal_radius", "clearance_major", "viscosity", "bearing_length",
+                "film_model"):
+        if key in spec:
+            spec[key] = arg.check(f"{name}.{key}", spec[key], CLEARANCE[key],
+                                  optional=key not in ("clearance", "journal_radius"))
+    if "wear_angle" in spec:
+        spec["wear_angle"] = arg.number(f"{name}.wear_angle", spec["wear_angle"])
+    major = spec.get("clearance_major")
+    if major is not None and major < spec["clearance"]:
+        raise ParameterError(f"{name}.clearance_major", f"must be >= clearance "
+                             f"({spec['clearance']:g} m), got {major:g}")
+    if spec.get("viscosity") is not None and not spec.get("bearing_length"):
+        raise ParameterError(f"{name}.bearing_length", "is required with viscosity (bearing "
+                             "length, m, > 0)")
+    if spec.get("contact") is not None:
+        spec["contact"] = arg.table(f"{name}.contact", spec["contact"], CONTACT_KW)
+    return spec
+
+
+def _stiffness_hint(kw: dict, spec: dict) -> str:
+    """A start for a missing contact stiffness: the scene's default for steel on steel."""
+    if "stiffness" in (kw.get("law_params") or {}) or not isinstance(kw.get("law", "impact"), str):
+        return ""
+    from .contact import cylinder_stiffness
+
+    rj = spec["journal_radius"]
+    K = cylinder_stiffness(rj, rj + spec["clearance"], 2.1e11, 0.3, 2.1e11, 0.3)
+    return (f"; for steel on steel the scenes' default is law_params['stiffness'] = {K:.3g} "
+            f"N/m^1.5 (from the radii), with 'damping' 300 N s/m and 'penetration' 1e-4 m")
+
+
 def _finish(kind, bodies, pins, others, loads, clearance_specs, contact_kw, q0, qd0, crank,
-            drive, gravity, baumgarte, **meta):
+            drive, gravity, baumgarte, body_argument="bodies", **meta):
     ideal_pins, clear = _split(pins, clearance_specs, contact_kw)
     assembly = Multibody(bodies, pins + others, [], loads, gravity, baumgarte)
     q, qd = assembly.assemble(0.0, q0, qd0)
@@ -161,9 +249,80 @@ def _finish(kind, bodies, pins, others, loads, clearance_specs, contact_kw, q0, 
         others = [c for c in others if not isinstance(c, AngleDrive)]
         extra = [drive]
     ideal = Multibody(bodies, pins + others, [], loads + extra, gravity, baumgarte)
-    _check_rank(ideal, q, f"{kind} with {len(bodies)} bodies")
+    _check_rank(ideal, q, f"{kind} with {len(bodies)} bodies", body_argument)
     system = Multibody(bodies, ideal_pins + others, clear, loads + extra, gravity, baumgarte)
     return Mechanism(kind=kind, system=system, ideal=ideal, q0=q, qd0=qd, crank=crank, **meta)
+
+
+def _check_common(speed_rpm, theta0, ramp_time, drive_torque, gravity, baumgarte,
+                  direction) -> dict:
+    """The arguments crank trains and the four-bar share, by the ``[dynamics]`` keys' rules."""
+    from .. import arguments as arg
+    from .scene_keys import SCHEMA, SOLVER
+
+    out = {"speed_rpm": arg.check("speed_rpm", speed_rpm, SCHEMA["speed_rpm"]),
+           "theta0": arg.number("theta0", theta0),
+           "ramp_time": arg.check("ramp_time", ramp_time, SCHEMA["ramp_time"]),
+           "drive_torque": arg.check("drive_torque", drive_torque, SCHEMA["drive_torque"],
+                                     optional=True),
+           "gravity": tuple(arg.check("gravity", gravity, SCHEMA["gravity"])),
+           "baumgarte": arg.check("baumgarte", baumgarte, SOLVER["baumgarte"], optional=True),
+           "direction": arg.one_of("direction", direction, (1, -1))}
+    if out["drive_torque"] is not None and out["ramp_time"] > 0.0:
+        raise ParameterError("ramp_time", "must be 0 with drive_torque (the torque drives), "
+                             f"got {out['ramp_time']:g}")
+    return out
+
+
+def _default_roles(body, n_cylinders: int) -> dict:
+    """The roles of a crank body's frames when ``crank_roles`` is not given: the frames
+    :func:`~.flexbuild.crank_body` names (``main_1``, ``main_2``…, ``pin_1``…, ``drive``), or
+    those of a plain crank (``main``, ``pin``)."""
+    import re
+
+    frames = list(body.frames)
+    mains = sorted((f for f in frames if re.fullmatch(r"main_\d+", f)), key=lambda f: int(f[5:]))
+    mains = mains or (["main"] if "main" in frames else [])
+    pins = [f"pin_{i}" for i in range(1, n_cylinders + 1)]
+    if not all(p in frames for p in pins):
+        pins = ["pin"] * n_cylinders if "pin" in frames else []
+    drive = "drive" if "drive" in frames else (mains[0] if mains else None)
+    if not mains or not pins:
+        raise ParameterError("crank_roles", "not given, and the crank body's frames "
+                             f"({', '.join(frames) or 'none'}) are not those of crank_body() "
+                             "(main_1.., pin_1.., drive) or of a plain crank (main, pin): give "
+                             "crank_roles = {'mains': [...], 'pins': [one per cylinder], "
+                             "'drive': ...}")
+    return {"mains": mains, "pins": pins, "drive": drive}
+
+
+def _check_roles(body, roles, n_cylinders: int) -> dict:
+    """``crank_roles`` (given, or the default of the body's frames) checked against the body."""
+    from .. import arguments as arg
+
+    if roles is None:
+        return _default_roles(body, n_cylinders)
+    roles = arg.table("crank_roles", roles, ("mains", "pins", "drive"),
+                      required=("mains", "pins", "drive"))
+    mains = roles["mains"] = list(roles["mains"]) if not isinstance(roles["mains"], str) \
+        else [roles["mains"]]
+    pins = roles["pins"] = list(roles["pins"])
+    if not mains:
+        raise ParameterError("crank_roles.mains", "needs at least one main journal frame")
+    if len(pins) != n_cylinders:
+        raise ParameterError("crank_roles.pins", f"needs one frame per cylinder "
+                             f"({n_cylinders}), got {len(pins)}")
+    for key, names in (("mains", mains), ("pins", pins), ("drive", [roles["drive"]])):
+        for i, frame in enumerate(names):
+            if frame not in body.frames:
+                where = "crank_roles.drive" if key == "drive" else f"crank_roles.{key}[{i}]"
+                raise ParameterError(where, f"the crank body has no frame {frame!r}; frames: "
+                                     f"{', '.join(body.frames)}")
+    return roles
+
+
+def _is_body(value) -> bool:
+    return all(hasattr(value, a) for a in ("frames", "ndof", "local", "frame_pose"))
 
 
 def _drive(crank, omega, theta0, ramp_time, drive_torque, crank_frame="main"):
@@ -221,7 +380,79 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     direction : {1, -1}
         Sense of rotation: 1 counter-clockwise (angles grow), -1 clockwise. A cylinder's angle
         from its top dead centre is ``direction * (theta - psi_i)``.
+    crank_body : body, optional
+        The crank as a body object (e.g. :func:`~.flexbuild.crank_body`'s), replacing the rigid
+        crank made from ``crank_mass``, ``crank_inertia`` and ``crank_com``. The speed is then
+        prescribed (``drive_torque`` None: the part carries no flywheel, as in scenes).
+    crank_roles : dict, optional
+        ``mains``, ``pins``, ``drive`` frame names of ``crank_body`` (see above); default: the
+        frames :func:`~.flexbuild.crank_body` makes (``main_1``…, ``pin_1``…, ``drive``).
+    rod_bodies : list, optional
+        One body (or None: rigid) per cylinder, frames ``big`` and ``small``.
+
+    Raises
+    ------
+    ParameterError
+        An argument out of its range, naming it (``crank_radius``, ``cylinders[0].rod_length``,
+        ``clearances.main.clearance``, ``crank_roles``…); the bounds are those of the
+        ``[dynamics]`` scene keys.
     """
+    from .. import arguments as arg
+    from .scene_keys import CRANK_TRAIN
+
+    common = _check_common(speed_rpm, theta0, ramp_time, drive_torque, gravity, baumgarte,
+                           direction)
+    speed_rpm, theta0, ramp_time = common["speed_rpm"], common["theta0"], common["ramp_time"]
+    drive_torque, gravity, baumgarte = (common["drive_torque"], common["gravity"],
+                                        common["baumgarte"])
+    crank_radius = arg.check("crank_radius", crank_radius, CRANK_TRAIN["crank_radius"])
+    crank_mass = arg.check("crank_mass", crank_mass, CRANK_TRAIN["crank_mass"])
+    crank_inertia = arg.check("crank_inertia", crank_inertia, CRANK_TRAIN["crank_inertia"])
+    crank_com = arg.check("crank_com", crank_com, CRANK_TRAIN["crank_com"])
+    if isinstance(cylinders, (str, bytes)) or not hasattr(cylinders, "__len__") or not cylinders:
+        raise ParameterError("cylinders", f"must be a non-empty list of Cylinder, got "
+                             f"{cylinders!r:.60}")
+    cylinders = list(cylinders)
+    for i, cyl in enumerate(cylinders):
+        arg.instance(f"cylinders[{i}]", cyl, Cylinder, "a Cylinder")
+    if rod_bodies is not None:
+        if isinstance(rod_bodies, (str, bytes)) or len(rod_bodies) != len(cylinders):
+            raise ParameterError("rod_bodies", f"needs one entry (a body, or None for a rigid "
+                                 f"rod) per cylinder ({len(cylinders)})")
+        for i, rod in enumerate(rod_bodies):
+            if rod is None:
+                continue
+            if not _is_body(rod):
+                raise ParameterError(f"rod_bodies[{i}]", f"must be a body (RigidBody, "
+                                     f"FlexibleBody) or None, got {rod!r:.60}")
+            missing = [f for f in ("big", "small") if f not in rod.frames]
+            if missing:
+                raise ParameterError(f"rod_bodies[{i}]", f"needs frames 'big' and 'small' "
+                                     f"(rod_body() makes them); it has {', '.join(rod.frames)}")
+    for i, cyl in enumerate(cylinders):
+        given = rod_bodies is not None and rod_bodies[i] is not None
+        if not given and cyl.rod_length <= crank_radius + abs(cyl.offset):
+            raise ParameterError(f"cylinders[{i}].rod_length", f"must exceed crank_radius + "
+                                 f"|offset| = {crank_radius + abs(cyl.offset):g} m, got "
+                                 f"{cyl.rod_length:g}")
+        if not given and cyl.rod_inertia <= 0.0:
+            raise ParameterError(f"cylinders[{i}].rod_inertia", "must be > 0 kg m^2 for a rigid "
+                                 "rod made from the parameters (0 only with a rod body given)")
+    if crank_body is not None:
+        if not _is_body(crank_body):
+            raise ParameterError("crank_body", f"must be a body (RigidBody, FlexibleBody, e.g. "
+                                 f"from crank_body()), got {crank_body!r:.60}")
+        if isinstance(crank_body, tuple):
+            raise ParameterError("crank_body", "got a tuple: crank_body() returns (body, roles)")
+        crank_roles = _check_roles(crank_body, crank_roles, len(cylinders))
+        if drive_torque is not None and not isinstance(crank_body, RigidBody):
+            raise ParameterError("drive_torque", "with a flexible crank the speed is "
+                                 "prescribed (the part carries no flywheel); give None")
+    elif crank_roles is not None:
+        raise ParameterError("crank_roles", "given without crank_body")
+    if drive_torque is not None and crank_body is None and crank_inertia <= 0.0:
+        raise ParameterError("crank_inertia", "must be > 0 (crank and flywheel, kg m^2) when "
+                             "drive_torque sets the speed free")
     omega = direction * speed_rpm * 2.0 * np.pi / 60.0
     baumgarte = max(50.0, 2.0 * abs(omega)) if baumgarte is None else baumgarte
     ground = Ground(frames={"main": (0.0, 0.0)})
@@ -254,6 +485,7 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         nrm = np.array([-u[1], u[0]])
         P = crank.frame_pose(q_crank, pin_frames[i - 1])[:2]
         rod = rod_bodies[i - 1] if rod_bodies and rod_bodies[i - 1] is not None else None
+        given_rod = None if rod is None else rod
         if rod is None:
             a, L = cyl.rod_com, cyl.rod_length
             rod = RigidBody(f"rod_{i}", cyl.rod_mass, cyl.rod_inertia,
@@ -265,7 +497,8 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         piston = RigidBody(f"piston_{i}", cyl.piston_mass, 1.0e-6, {"pin": (0.0, 0.0)}, z=cyl.z)
         h = P @ nrm - cyl.offset
         if abs(h) >= L:
-            raise ValueError(f"cylinder {i}: rod length {L} m cannot reach the crankpin")
+            where = f"rod_bodies[{i - 1}]" if given_rod is not None else f"cylinders[{i - 1}]"
+            raise ParameterError(where, f"the rod ({L:.5g} m) cannot reach the crankpin")
         s = P @ u + np.sqrt(L * L - h * h)
         X = s * u + cyl.offset * nrm
         d = X - P
@@ -286,7 +519,8 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     return _finish(kind, bodies, pins, others, loads, clearances or {}, contact_kw or {},
                    np.array(q0), np.array(qd0), crank, drive, gravity, baumgarte,
                    pistons=pistons, axes=axes, revolution_hz=speed_rpm / 60.0, rows_z=rows_z,
-                   main_joint=main_names[0], main_joints=main_names)
+                   main_joint=main_names[0], main_joints=main_names,
+                   body_argument="crank_body" if crank_body is not None else "cylinders")
 
 
 #: relative tolerance on the distance between a link body's two joint frames and its length
@@ -299,8 +533,6 @@ FOUR_BAR_JOINTS = {"crank": ("A", "B"), "coupler": ("B", "C"), "rocker": ("D", "
 def _link_length(body, role: str, length: float) -> float:
     """Distance between a given link body's two joint frames (undeformed), m, checked against
     the link's ``length`` (±:data:`LINK_TOLERANCE`)."""
-    from ..errors import ParameterError
-
     f0, f1 = FOUR_BAR_JOINTS[role]
     missing = [f for f in (f0, f1) if f not in body.frames]
     if missing:
@@ -391,8 +623,40 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
     Raises
     ------
     ParameterError
-        A given body lacks its joint frames, or they are not its link's length apart.
+        An argument out of its range, naming it (the ``[dynamics.four_bar]`` keys' rules:
+        lengths and masses > 0, inertias >= 0, three entries each; ``branch`` 1 or -1); a
+        given body lacks its joint frames, or they are not its link's length apart; the links
+        cannot be assembled at ``theta0`` (naming ``rocker_pivot``).
     """
+    from .. import arguments as arg
+    from .scene_keys import FOUR_BAR
+
+    common = _check_common(speed_rpm, theta0, ramp_time, drive_torque, gravity, baumgarte,
+                           direction)
+    speed_rpm, theta0, ramp_time = common["speed_rpm"], common["theta0"], common["ramp_time"]
+    drive_torque, gravity, baumgarte = (common["drive_torque"], common["gravity"],
+                                        common["baumgarte"])
+    length_rule = FOUR_BAR["lengths"]
+    crank_length, coupler_length, rocker_length = (
+        arg.number(name, value, gt=length_rule.gt) for name, value in
+        (("crank_length", crank_length), ("coupler_length", coupler_length),
+         ("rocker_length", rocker_length)))
+    rocker_pivot = arg.check("rocker_pivot", rocker_pivot, FOUR_BAR["rocker_pivot"])
+    masses = arg.check("masses", masses, FOUR_BAR["masses"])
+    inertias = arg.check("inertias", inertias, FOUR_BAR["inertias"])
+    com_fractions = arg.check("com_fractions", com_fractions, FOUR_BAR["com_fractions"])
+    extra_rocker_inertia = arg.check("extra_rocker_inertia", extra_rocker_inertia,
+                                     FOUR_BAR["extra_rocker_inertia"])
+    branch = arg.check("branch", branch, FOUR_BAR["branch"])
+    for role, body in (("crank", crank_body), ("coupler", coupler_body),
+                       ("rocker", rocker_body)):
+        if body is not None and not _is_body(body):
+            raise ParameterError(f"{role}_body", f"must be a body (RigidBody, FlexibleBody, "
+                                 f"e.g. from link_body()), got {body!r:.60}")
+    if drive_torque is not None and crank_body is None and masses[0] > 0 \
+            and inertias[0] + masses[0] * (com_fractions[0] * crank_length) ** 2 <= 0.0:
+        raise ParameterError("inertias", "the crank's inertia must be > 0 when drive_torque "
+                             "sets the speed free")
     omega = direction * speed_rpm * 2.0 * np.pi / 60.0
     baumgarte = max(50.0, 2.0 * abs(omega)) if baumgarte is None else baumgarte
     D = np.asarray(rocker_pivot, float)
@@ -420,7 +684,10 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
     BD = D - B
     dist = np.hypot(*BD)
     if not abs(l2 - l3) < dist < l2 + l3:
-        raise ValueError("four-bar cannot be assembled at the initial crank angle")
+        raise ParameterError("rocker_pivot", f"the four-bar cannot be assembled at theta0 = "
+                             f"{theta0:g} rad: B is {dist:.5g} m from the pivot D, the coupler "
+                             f"and rocker ({l2:.5g} + {l3:.5g} m) reach only "
+                             f"{abs(l2 - l3):.5g} to {l2 + l3:.5g} m")
     x = (dist**2 + l2**2 - l3**2) / (2 * dist)
     y = branch * np.sqrt(l2**2 - x**2)
     ebd = BD / dist
@@ -431,8 +698,6 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
     if crank_body is not None:
         turn = float(crank.frame_pose(qs[0], "A")[2] - theta0)
         if abs(np.angle(np.exp(1j * turn))) > 1e-9:
-            from ..errors import ParameterError
-
             raise ParameterError("crank_body", "its A frame's angle must be the crank angle "
                                  "(body x axis from A towards B, no angle offset at A); it is "
                                  f"{np.rad2deg(turn):.4g} deg off")
@@ -446,4 +711,7 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
     angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque, "A")
     return _finish("four_bar", [crank, coupler, rocker], pins, [angle_drive], [],
                    clearances or {}, contact_kw or {}, q0, qd0, crank, drive, gravity,
-                   baumgarte, revolution_hz=speed_rpm / 60.0, main_joint="A")
+                   baumgarte, revolution_hz=speed_rpm / 60.0, main_joint="A",
+                   body_argument=next((f"{r}_body" for r, b in (("crank", crank_body),
+                                       ("coupler", coupler_body), ("rocker", rocker_body))
+                                       if b is not None), "bodies"))

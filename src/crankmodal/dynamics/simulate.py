@@ -28,9 +28,11 @@ class SolverSettings:
     Parameters
     ----------
     method : str
-        ``solve_ivp`` method: ``RK45`` (default: impacts limit the step through the error
-        control long before stiffness does; measured 1.5-5x fewer evaluations than LSODA and
-        Radau for contact stiffness 1e10..1e13), ``LSODA``, ``Radau``, ``BDF``, ``DOP853``.
+        ``auto`` (default, as in scenes: chosen by :func:`auto_method` for the mechanism
+        :func:`~.analysis.simulate` or :func:`integrate` runs) or a ``solve_ivp`` method: ``RK45`` (impacts limit
+        the step through the error control long before stiffness does; measured 1.5-5x fewer
+        evaluations than LSODA and Radau for contact stiffness 1e10..1e13), ``LSODA``,
+        ``Radau``, ``BDF``, ``DOP853``.
     rtol : float
         Relative tolerance.
     atol : float
@@ -45,15 +47,106 @@ class SolverSettings:
         The clearance joints' contact time scales (:mod:`.timescales`), if estimated: the advice
         of a failed run then names the key that limits the step (``contact.damping`` or
         ``contact.stiffness``).
+
+    Raises
+    ------
+    ParameterError
+        Naming the field out of its range (the ``[dynamics.solver]`` keys' rules: ``method``
+        one of :data:`~.scene_keys.METHODS`, ``0 < rtol < 1``, ``atol > 0``,
+        ``max_rhs_evals >= 1``; ``velocity_scale > 0``, ``max_step`` None or ``> 0`` s).
     """
 
-    method: str = "RK45"
+    method: str = "auto"
     rtol: float = 1e-6
     atol: float = 1e-9
     velocity_scale: float = 1000.0
     max_step: float | None = None
     max_rhs_evals: int = 2_000_000
     time_scales: tuple = ()
+
+    def __post_init__(self):
+        from .. import arguments as arg
+        from .scene_keys import METHODS, SOLVER
+
+        arg.one_of("method", self.method, METHODS)
+        self.rtol = arg.check("rtol", self.rtol, SOLVER["rtol"])
+        self.atol = arg.check("atol", self.atol, SOLVER["atol"])
+        self.velocity_scale = arg.number("velocity_scale", self.velocity_scale, gt=0.0)
+        self.max_step = arg.number("max_step", self.max_step, gt=0.0, optional=True)
+        self.max_rhs_evals = arg.check("max_rhs_evals", self.max_rhs_evals,
+                                       SOLVER["max_rhs_evals"])
+        if not isinstance(self.time_scales, tuple):
+            self.time_scales = tuple(self.time_scales)
+
+
+def auto_method(joints, omega: float, flexible: bool) -> str:
+    """The integration method of ``method = "auto"`` (scenes and :func:`~.analysis.simulate`).
+
+    RK45, the fastest measured, also for stiff contact; LSODA when a joint's friction sticks
+    (slow sliding) or with an oil film; with flexible bodies Radau on ideal joints or with an
+    oil film.
+
+    Parameters
+    ----------
+    joints : sequence of (float, str, float, bool)
+        Per clearance joint: journal radius (m), friction law name (``"none"`` without
+        friction), the friction law's transition velocity ``v_dynamic`` (m/s), and whether it is
+        lubricated (a viscosity given).
+    omega : float
+        Crank speed, rad/s.
+    flexible : bool
+        The mechanism has flexible bodies with elastic modes.
+
+    Returns
+    -------
+    str
+        A ``solve_ivp`` method name.
+    """
+    joints = list(joints)
+    method = "RK45"
+    r_max = max((j[0] for j in joints), default=0.0)
+    v_dyn = [j[2] for j in joints if j[1] != "none"]
+    # near stiction the friction law's slope mu_s / v_s makes the problem stiff when the
+    # journal slides slowly at the working speed (a brief start-up ramp is cheaper in RK45:
+    # measured 10 k against 51 k evaluations for the four-star's 0.1 s ramp)
+    if v_dyn and r_max * abs(omega) < 10.0 * max(v_dyn):
+        method = "LSODA"
+    # an oil film is stiff near the wall ((1 - eps^2)^-5/2): measured 0.8 s LSODA, minutes RK45
+    lubricated = any(j[3] for j in joints)
+    if lubricated:
+        method = "LSODA"
+    # flexible bodies on ideal joints: their stiffest modes (kHz) bound an explicit step by
+    # stability, which A-stable Radau IIA steps over. Measured (benchmarks/README.md):
+    # slider-crank, crank 20 + rod 14 modes to 22.6 kHz, 0.1 s: Radau 19 k evaluations,
+    # 0.10 simulated s per wall s, against RK45 59 k, 0.038, and Radau nearer a tight
+    # reference (4e-4 against 2e-3 of the peak). With impacts RK45 stays: four-star with a
+    # flexible crank and rods and one clearance, 0.3 s: RK45 64 k evaluations in 4.9 s,
+    # Radau 236 k in 128 s (every contact onset restarts it with a new Jacobian).
+    # with an oil film too (measured: the loom's coupler with the seed's lubricated C
+    # joint, LSODA stalled at 0.17 of 0.4 s after 2 M evaluations, Radau ran it in 95 k;
+    # the four-star with a lubricated big end and flexible rods, Radau 2.5 k evaluations in
+    # 2.2 s against LSODA's 9.1 k in 6.6 s)
+    if flexible and (not joints or lubricated):
+        method = "Radau"
+    return method
+
+
+def system_method(sysm, omega: float | None = None, qd0=None) -> str:
+    """:func:`auto_method` for a built :class:`~.system.Multibody` at crank speed ``omega``
+    (rad/s): its clearance joints and whether a body keeps elastic modes. Without ``omega``:
+    the speed of its angle drive, else the fastest body rotation in ``qd0`` (rad/s)."""
+    if omega is None:
+        from .joints import AngleDrive
+
+        drives = [abs(c.profile.omega) for c in sysm.constraints if isinstance(c, AngleDrive)]
+        spins = [abs(float(qd0[sysm.slices[id(b)].start + 2])) for b in sysm.bodies] \
+            if qd0 is not None else []
+        omega = max(drives or spins or [0.0])
+    joints = [(cj.journal_radius, cj.friction,
+               float(cj.friction_law.params().get("v_dynamic", 0.0)), cj.viscosity is not None)
+              for cj in sysm.clearances]
+    flexible = any(getattr(b, "n_elastic", 0) > 0 for b in sysm.bodies)
+    return auto_method(joints, omega, flexible)
 
 
 @dataclass
@@ -178,6 +271,10 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     """
     from scipy.integrate import solve_ivp
 
+    if settings.method == "auto":  # simulate() decides it at the mechanism's speed already
+        from dataclasses import replace
+
+        settings = replace(settings, method=system_method(sysm, qd0=qd0))
     n = sysm.n
     y = np.concatenate([q0, qd0, np.zeros(N_AUX)])
     atol = np.concatenate([np.full(n, settings.atol), np.full(n, settings.atol * settings.velocity_scale),

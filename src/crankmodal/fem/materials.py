@@ -51,6 +51,17 @@ class Material:
     description: str = ""
 
     def __post_init__(self):
+        import math
+        from numbers import Real
+
+        for key, optional in (("E", False), ("nu", False), ("rho", False),
+                              ("yield_strength", True), ("ultimate_strength", True)):
+            v = getattr(self, key)
+            if v is None and optional:
+                continue
+            if isinstance(v, bool) or not isinstance(v, Real) or not math.isfinite(v):
+                raise ParameterError(key, f"must be a finite number, got {v!r} ({self.name})")
+            object.__setattr__(self, key, float(v))
         for key, value, ok, text in (
             ("E", self.E, self.E > 0, "> 0 Pa"),
             ("nu", self.nu, -1.0 < self.nu < 0.5, "in (-1, 0.5)"),

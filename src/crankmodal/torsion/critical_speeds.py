@@ -18,6 +18,8 @@ from ..errors import ParameterError
 
 #: Order families by machine type.
 ORDER_TYPES = ("compressor", "two_stroke", "four_stroke")
+#: highest excitation order (the ``torsion.max_order`` key's bound)
+MAX_ORDER = 100.0
 
 
 def excitation_orders(order_type: str, max_order: float) -> np.ndarray:
@@ -143,7 +145,14 @@ def critical_speeds(
         ``max_order``; the ``[torsion]`` stage re-raises it under its scene key
         (``torsion.operating_speed_rpm``).
     """
-    lo, hi = (float(v) for v in speed_range_rpm)
+    from .. import arguments as arg
+
+    natural_hz = arg.numbers("natural_hz", np.atleast_1d(np.asarray(natural_hz, dtype=object)),
+                             ge=0.0)
+    max_order = arg.number("max_order", max_order, gt=0.0, le=MAX_ORDER)
+    required_margin = arg.number("required_margin", required_margin, ge=0.0)
+    operating_rpm = arg.number("operating_rpm", operating_rpm, optional=True)
+    lo, hi = arg.numbers("speed_range_rpm", speed_range_rpm, length=2)
     if not (0.0 <= lo < hi):
         raise ParameterError("speed_range_rpm", f"need 0 <= min < max, got [{lo:g}, {hi:g}]")
     if operating_rpm is not None and not operating_rpm > 0.0:

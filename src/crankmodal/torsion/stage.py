@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import NumericalError, SceneError, scene_keys
 from ..schema import Field
 from ..schema import validate as validate_table
-from .critical_speeds import ORDER_TYPES
+from .critical_speeds import MAX_ORDER, ORDER_TYPES
 from .equivalent_length import THROW_FORMS
 from .inertias import SEED_RECIPROCATING_FACTOR
 
@@ -49,7 +49,7 @@ SCHEMA: dict[str, Field] = {
                                 choices=("auto", "first", "last")),
     "order_type": Field("str", "compressor", "integer orders (compressor, two_stroke) or half orders (four_stroke)",
                         choices=ORDER_TYPES),
-    "max_order": Field("float", 12.0, "highest excitation order", gt=0.0, le=100.0),
+    "max_order": Field("float", 12.0, "highest excitation order", gt=0.0, le=MAX_ORDER),
     "speed_range_rpm": Field("floats", None, "running-speed range [min, max], rpm (default [0, 1.25 x operating])",
                              ge=0.0, length=2, check=_range_check),
     "operating_speed_rpm": Field("float", None, "operating speed, rpm", gt=0.0),
