@@ -92,3 +92,25 @@ def test_one_pin_leaves_the_swing_free_and_reports_the_first_cantilever_like_mod
     beta = brentq(lambda b: np.tan(b) - np.tanh(b), 3.8, 3.95)
     assert e["frequency_hz"] == pytest.approx(beta**2 / (2 * np.pi), rel=2e-3)
     assert 0.0 < e["damping_ratio"] < 0.02
+
+
+def test_a_crank_is_held_at_its_main_journals_only_and_overconstrained_bodies_give_none():
+    """A crank's crankpins carry the light rods: only its main journals are held (here the
+    beam's end0 as the main journal, end1 as the pin: the pinned-free mode). Holding more
+    coordinates than the body has (three pins on a 1-mode body) leaves no mode: None."""
+    from crankmodal.dynamics.modal_damping import pinned_interfaces
+
+    body, *_ = _beam(0.02)
+    body.info["roles"] = {"mains": ["end0"], "pins": ["end1"], "drive": "end0"}
+    assert pinned_interfaces(body) == ["end0"]
+    e = effective_damping(body)
+    beta = brentq(lambda b: np.tan(b) - np.tanh(b), 3.8, 3.95)
+    assert e["frequency_hz"] == pytest.approx(beta**2 / (2 * np.pi), rel=2e-3)
+    centres = {"a": [0.0, 0.0, 0.0], "b": [1.0, 0.0, 0.0], "c": [0.5, 0.5, 0.0]}
+    one = FlexibleBody("one", 1.0, 1.0 / 12.0, [0.5, 0.0], [10.0], np.eye(1), np.zeros(1),
+                       np.zeros((1, 1)),
+                       {n: (c, np.r_[0.0, 1.0 if n != "c" else 0.0, 0, 0, 0, 0][:, None])
+                        for n, c in centres.items()},
+                       info={"interface_centres": centres})
+    assert effective_damping(one, pinned=["a", "b"])["frequency_hz"] > 0.0
+    assert effective_damping(one, pinned=["a", "b", "c"]) is None   # 6 rows hold x, y, θ, ξ

@@ -25,11 +25,14 @@ import scipy.linalg as sla
 
 
 def pinned_interfaces(body) -> list[str]:
-    """The interfaces a body is joined at: its roles (a four-bar link's joints, a crank's main
-    journals and crankpins) or, without roles, every interface of its file."""
+    """The interfaces held for a body's constrained modes: a crank's main journals (its joints
+    to the ground; the crankpins carry the light rods and stay free), a four-bar link's joints
+    (``roles``), or, without roles, every interface of its file (a rod's two eyes)."""
     roles = body.info.get("roles")
     names = []
-    if roles:
+    if roles and "mains" in roles:
+        names = list(roles["mains"])
+    elif roles:
         for role, v in roles.items():
             if role == "drive":  # where the drive acts: a journal already, or a free flange
                 continue
@@ -72,6 +75,8 @@ def damped_modes(M, C, K) -> tuple[np.ndarray, np.ndarray]:
     oscillating eigenvalues of ``s² M + s C + K`` (one per conjugate pair), lowest first.
     Zero roots (free rigid motion) and overdamped real roots are left out."""
     r = len(M)
+    if r == 0:  # the constraints hold every coordinate
+        return np.zeros(0), np.zeros(0)
     Minv = np.linalg.inv(M)
     A = np.block([[np.zeros((r, r)), np.eye(r)], [-Minv @ K, -Minv @ C]])
     s = np.linalg.eigvals(A)
@@ -91,7 +96,8 @@ def effective_damping(body, pinned=None) -> dict | None:
     dict or None
         ``frequency_hz`` (Hz), ``damping_ratio`` (effective, of that mode), ``given_ratio``
         (on the lowest free-free mode), ``free_free_hz``, ``pinned`` (interface names); None
-        for a body without elastic modes or without an oscillating constrained mode.
+        for a body without elastic modes or without an oscillating constrained mode (the
+        pins hold every coordinate).
     """
     if body.n_elastic == 0:
         return None
