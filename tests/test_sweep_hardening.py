@@ -272,25 +272,31 @@ def test_documented_example_runs_and_its_search_finds_the_closed_form_optimum(tm
     assert s["best_value"] / aligned == pytest.approx(2 / math.sqrt(3), rel=1.2e-4)
 
 
-def test_documented_examples_check_and_a_dynamics_axis_on_a_mechanism_scene_is_named(
-        tmp_path, capsys):
+def test_documented_clearance_example_checks_without_running(tmp_path, capsys):
     assert main(["sweep", str(SWEEPS / "example_clearance.toml"), "--out", str(tmp_path / "c"),
                  "--dry-run"]) == 0
     assert "6 points checked, 0 recorded" in capsys.readouterr().out
     assert not (tmp_path / "c").exists()
-    # the README's first version: a dynamics axis over a base scene without [dynamics]
-    text = (SWEEPS / "example.toml").read_text().replace(
-        '"mechanism.speed_rpm" = [1000, 1480, 2000]',
-        '"mechanism.speed_rpm" = [1000, 1480, 2000]\n'
-        '"dynamics.clearances.0.clearance" = { start = 2e-5, stop = 2e-4, num = 4, log = true }')
-    sw = tmp_path / "readme.toml"
-    sw.write_text(text.replace('base = "../four_star_mechanism.toml"', f'base = "{MECH}"'))
-    assert main(["sweep", str(sw), "--out", str(tmp_path / "o"), "--dry-run"]) == 2
+
+
+def test_dynamics_axis_on_a_base_scene_without_dynamics_names_the_missing_section(tmp_path,
+                                                                                  capsys):
+    """The README's first example: a clearance axis over four_star_mechanism.toml. The error
+    blamed the list type of dynamics.clearances (the override had made up a [dynamics] of one
+    key); the cause is the base scene's missing [dynamics]."""
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n[axes]\n"
+                     "mechanism.speed_rpm = [1000, 1480, 2000]\n"
+                     '"dynamics.clearances.0.clearance" = { start = 2e-5, stop = 2e-4, num = 4, '
+                     "log = true }\n")
+    with pytest.raises(SceneError, match=r"^axes.dynamics.clearances.0.clearance: the base "
+                                         r"scene four_star_mechanism.toml has no \[dynamics\]"):
+        run_sweep(sw, tmp_path / "o")
+    assert main(["sweep", str(sw), "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(
         "crankmodal: error: axes.dynamics.clearances.0.clearance: the base scene "
         "four_star_mechanism.toml has no [dynamics] section (it has [mechanism])")
-    assert "list of tables" not in err[0]
+    assert "list of tables" not in err[0] and not (tmp_path / "o").exists()
 
 
 def test_dry_run_counts_recorded_points(tmp_path, client, capsys):
@@ -340,10 +346,11 @@ def test_search_refinement_values_without_float_noise():
 
 
 def test_log_axis_values_keep_their_digits_and_lose_the_noise():
-    """A geometric axis: its ends exact, a decade grid 1e-5, 1e-4, 1e-3 as written, and the
-    irrational values within 1e-9 relative of the true geometric mean sequence (numpy)."""
-    c = parse_axis("z", {"start": 1e-5, "stop": 1e-3, "num": 3, "log": True})
-    assert [repr(v) for v in c.values] == ["1e-05", "0.0001", "0.001"]
+    """A geometric axis: its ends exact, a decade grid as written (np.geomspace(1e-6, 1e-3, 4)
+    gives 9.999999999999999e-06), and irrational values within 1e-9 relative of the exact
+    geometric sequence."""
+    c = parse_axis("z", {"start": 1e-6, "stop": 1e-3, "num": 4, "log": True})
+    assert [repr(v) for v in c.values] == ["1e-06", "1e-05", "0.0001", "0.001"]
     g = parse_axis("g", {"start": 2e-5, "stop": 2e-4, "num": 4, "log": True})
     exact = 2e-5 * 10 ** (np.arange(4) / 3)
     assert np.allclose(g.values, exact, rtol=1e-9, atol=0)
