@@ -37,6 +37,30 @@ def flexbody_cache_dir() -> Path:
     return Path(root) / "flexbodies"
 
 
+def cached_flexbody(path: Path, where: str) -> bool:
+    """Whether ``path`` holds a sound cached flexbody. A damaged one (truncated, bit-flipped,
+    emptied: :func:`~crankmodal.reduction.io.load_flexbody` refuses it) is removed with a
+    one-line warning naming it and what is wrong, so that the caller rebuilds it, as
+    :mod:`crankmodal.geometry.cache` does for parts."""
+    from ..errors import InputFileError, warn
+    from ..reduction.io import load_flexbody
+
+    if not path.is_file():
+        return False
+    try:
+        load_flexbody(path)
+        return True
+    except InputFileError as exc:
+        why = getattr(exc, "member", "")
+        why = f"{why}: {exc.text}" if why else getattr(exc, "text", str(exc))
+        warn(f"{where}: the cached flexbody {path} is damaged ({why}); rebuilding it")
+        try:
+            path.unlink()
+        except OSError:
+            pass  # save_flexbody replaces it atomically anyway
+        return False
+
+
 def _reduction_source_digest() -> str:
     h = hashlib.sha256()
     for folder in ("reduction", "fem"):
@@ -103,7 +127,7 @@ def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
                            "source": _reduction_source_digest(), "format": 1}, sort_keys=True)
     key = hashlib.sha256(key_text.encode()).hexdigest()[:32]
     path = flexbody_cache_dir() / f"{machine}_{part}_{key}.npz"
-    if path.is_file():
+    if cached_flexbody(path, where):
         return path
     import time
 
@@ -310,6 +334,48 @@ def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
     return body
 
 
+def check_bar(length: float, section, spec: dict, key: str) -> tuple:
+    """Refuse the bar of :func:`reduced_bar` before anything is built; return its divisions.
+
+    Its sides (``length``, ``section``) must be sizes crankmodal builds
+    (:data:`~crankmodal.geometry.checks.MIN_LENGTH` to ``MAX_LENGTH``), and its tetrahedra at
+    ``spec["mesh_size"]`` no more than the limit of parts meshed by gmsh
+    (:data:`~crankmodal.geometry.mesh.MAX_ELEMENTS`, or fewer when the memory available could not
+    hold the reduction's factorisation: :func:`~crankmodal.geometry.mesh.fe_element_limit`).
+
+    Raises
+    ------
+    SceneError
+        A side out of range, naming ``<key>.bar`` (or ``dynamics.four_bar.lengths``).
+    ResourceError
+        Too many tetrahedra, naming ``<key>.mesh_size`` and the smallest size allowed.
+    """
+    from ..errors import ResourceError
+    from ..fem.memory import available_bytes
+    from ..fem.testparts import check_bar_size
+    from ..geometry.checks import MAX_LENGTH, MIN_LENGTH
+    from ..geometry.mesh import MAX_ELEMENTS, MeshSizeError, fe_element_limit
+
+    sizes = f"the sizes crankmodal builds, [{MIN_LENGTH:g}, {MAX_LENGTH:g}] m"
+    if not MIN_LENGTH <= length <= MAX_LENGTH:
+        raise SceneError(f"dynamics.four_bar.lengths: the {key.rsplit('.', 1)[-1]} bar reduced "
+                         f"here is {length:.6g} m long, outside {sizes}")
+    for v in section:
+        if not MIN_LENGTH <= v <= MAX_LENGTH:
+            raise SceneError(f"{key}.bar: every side must be in {sizes}, got {v:.6g}")
+    limit, reason = MAX_ELEMENTS, "crankmodal's limit on the mesh size"
+    avail = available_bytes()
+    fe = fe_element_limit(spec["element_order"], avail)
+    if fe is not None and fe < limit:
+        limit = fe
+        reason = (f"the P{spec['element_order']} elements whose FE factorisation, "
+                  f"0.42 GB x (DOF / 85k)^1.5, fits in the {avail / 1e9:.3g} GB available")
+    try:
+        return check_bar_size((length, *map(float, section)), spec["mesh_size"], limit, reason)
+    except MeshSizeError as exc:
+        raise ResourceError(exc.worded(f"{key}.mesh_size")) from None
+
+
 def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
     """The ``crankmodal-flexbody`` file of a prismatic steel (or ``spec["material"]``) bar
     between two pins, reduced once and cached.
@@ -330,9 +396,8 @@ def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
     from ..reduction.io import save_flexbody
     from ..reduction.reduce import reduce_body
 
+    div = check_bar(length, section, spec, key)
     width, thickness = (float(v) for v in section)
-    h = spec["mesh_size"]
-    div = tuple(max(1, int(np.ceil(d / h))) for d in (length, width, thickness))
     try:
         mp = validate_material({"name": spec["material"]}, None)
     except SceneError as exc:
@@ -343,7 +408,7 @@ def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
                            "source": _reduction_source_digest(), "format": 1}, sort_keys=True)
     digest = hashlib.sha256(key_text.encode()).hexdigest()[:32]
     path = flexbody_cache_dir() / f"bar_{digest}.npz"
-    if path.is_file():
+    if cached_flexbody(path, key):
         return path
     part = bar(length, width, thickness, div, order=spec["element_order"])
     mat = make_material(mp)
@@ -438,5 +503,6 @@ def rigid_twin(body):
     return RigidBody(body.name, body.mass, body.j0 + body.attached_inertia, frames, z=body.z)
 
 
-__all__ = ["crank_body", "crank_interface_specs", "flexbody_cache_dir", "link_body", "read",
+__all__ = ["cached_flexbody", "check_bar", "crank_body", "crank_interface_specs",
+           "flexbody_cache_dir", "link_body", "read",
            "reduced_bar", "reduced_part", "rigid_twin", "rod_body"]

@@ -280,6 +280,13 @@ def validate_section(raw: dict) -> dict:
     p["solver"] = validate("dynamics.solver", p["solver"], SOLVER)
     p["flexible"] = validate_flexible(p["flexible"], p["mechanism"])
     _cross_checks(p)
+    if p["mechanism"] == "four_bar":  # a bar reduced here: its size refused before it is meshed
+        from .flexbuild import check_bar
+
+        for length, role in zip(p["four_bar"]["lengths"], FOUR_BAR_LINKS):
+            spec = p["flexible"].get(role)
+            if spec is not None and spec["bar"] is not None:
+                check_bar(float(length), spec["bar"], spec, f"dynamics.flexible.{role}")
     return p
 
 

@@ -45,11 +45,70 @@ def _grid(n):
     return m.p.T.copy(), m.t.T.copy()
 
 
+#: Tetrahedra per hexahedral cell of the structured grid (scikit-fem's ``MeshTet.init_tensor``).
+TETS_PER_CELL = 6
+
+
+def bar_divisions(dims, size: float) -> tuple:
+    """Cells along each side of a box ``dims`` (m) at about ``size`` (m) per edge:
+    ``max(1, ceil(d / size))`` each, as floats (``inf`` for a subnormal size, so that
+    :func:`bar_elements` can refuse it before any integer or array is made)."""
+    return tuple(max(1.0, float(np.ceil(d / size))) for d in dims)
+
+
+def bar_elements(divisions) -> float:
+    """Tetrahedra of a :func:`bar` with ``divisions`` cells: ``6 nx ny nz``."""
+    n = float(TETS_PER_CELL)
+    for d in divisions:  # Python floats: an overflow is inf, without a warning
+        n *= float(d)
+    return n
+
+
+def check_bar_size(dims, size: float, max_elements: float, reason: str) -> tuple:
+    """The integer divisions of a bar ``dims`` (m) meshed at ``size`` (m), refused when its
+    tetrahedra exceed ``max_elements`` (before any memory is taken: a 1 µm size on a 75 mm
+    coupler is 2e17 tetrahedra, a 2 PiB grid).
+
+    Raises
+    ------
+    MeshSizeError
+        Naming ``size``, the count, the limit (``reason`` says why it is what it is) and the
+        smallest size it allows.
+    """
+    from ..geometry.mesh import MeshSizeError
+
+    div = bar_divisions(dims, size)
+    n = bar_elements(div)
+    if n > max_elements:
+        lo, hi = min(dims) * 1e-9, max(dims)  # bisection on log h: the count falls with h
+        for _ in range(200):
+            mid = (lo * hi) ** 0.5
+            lo, hi = (mid, hi) if bar_elements(bar_divisions(dims, mid)) > max_elements else (lo, mid)
+        grid = " x ".join(f"{d:.3g}" for d in div)
+        box = " x ".join(f"{d:g}" for d in dims)
+        raise MeshSizeError(size, "exactly", n, f"6 per cell of a {grid} grid on the {box} m bar",
+                            max_elements, reason, hi)
+    return tuple(int(d) for d in div)
+
+
 def bar(length=1.0, width=0.05, height=0.05, divisions=(20, 2, 2), order=2) -> Part:
     """A prismatic bar along x, cross-section width (y) × height (z), m, centred on the x axis.
 
     Regions: ``end_x0`` (x = 0), ``end_x1`` (x = length), ``top`` (z = +h/2), ``bottom``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``divisions`` when they make more than
+        :data:`~crankmodal.geometry.mesh.MAX_ELEMENTS` tetrahedra (refused before the grid is
+        made, instead of a MemoryError).
     """
+    from ..errors import ParameterError
+    from ..geometry.mesh import MAX_ELEMENTS
+
+    if bar_elements(divisions) > MAX_ELEMENTS:
+        raise ParameterError("divisions", f"{tuple(divisions)} makes {bar_elements(divisions):.3g} "
+                             f"tetrahedra, over crankmodal's limit of {MAX_ELEMENTS:.3g}")
     p, t = _grid(divisions)
     scale = np.array([length, width, height])
     p = p * scale - np.array([0.0, width / 2, height / 2])

@@ -4,7 +4,7 @@ A part is stored under ``$CRANKMODAL_CACHE/parts/<key>.pkl`` (default ``~/.cache
 where ``key`` is the SHA-256 of its kind, parameters, fidelity, mesh settings, the crankmodal
 and gmsh versions, the source of this geometry package (so an edited builder never serves a
 stale part) and, for imports, the file's content hash. Files are written atomically;
-an unreadable entry is ignored and rebuilt.
+an unreadable entry is removed with a one-line warning and rebuilt.
 """
 
 from __future__ import annotations
@@ -51,15 +51,29 @@ def part_key(description: dict) -> str:
 
 
 def load_part(key: str):
-    """The cached part of ``key``, or None."""
+    """The cached part of ``key``, or None: absent, or damaged (unreadable, truncated, not a
+    part), which is removed with a one-line warning so that the caller rebuilds it."""
+    from ..part import Part
+
     path = cache_dir() / f"{key}.pkl"
     if not path.is_file():
         return None
     try:
         with open(path, "rb") as fh:
-            return pickle.load(fh)
-    except Exception:  # noqa: BLE001 - a truncated or stale entry is rebuilt, never trusted
-        return None
+            part = pickle.load(fh)
+        if isinstance(part, Part):
+            return part
+        why = f"holds a {type(part).__name__}, not a part"
+    except Exception as exc:  # noqa: BLE001 - a truncated or stale entry is rebuilt, never trusted
+        why = f"{type(exc).__name__}: {exc}"
+    from ..errors import warn
+
+    warn(f"geometry.cache: the cached part {path} is damaged ({why}); rebuilding it")
+    try:
+        path.unlink()
+    except OSError:
+        pass  # store_part replaces it atomically anyway
+    return None
 
 
 def store_part(key: str, part) -> Path:

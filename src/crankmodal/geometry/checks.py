@@ -6,6 +6,10 @@ received (an unknown fidelity: a ParameterError naming ``fidelity``), e.g.::
 
     crankshaft.web_width: must be >= 0.0735 m (web must hold the pin and its fillet), got 0.06
 
+Last, every length must lie in the sizes crankmodal builds (:func:`check_lengths`: 1 µm to
+100 m, spanning at most five decades); that refusal is a :class:`LengthError`, a GeometryError
+and a ParameterError naming ``<part>.<parameter>``.
+
 The rules keep a small margin (``MARGIN``) between features so that the solids gmsh receives
 have no slivers; the margins are part of the documented admissible space.
 """
@@ -14,9 +18,9 @@ from __future__ import annotations
 
 import math
 
-from ..errors import GeometryError
+from ..errors import GeometryError, ParameterError
 from .conrod import bolt_offset
-from .params import FIDELITIES, ConrodParams, CrankshaftParams
+from .params import FIDELITIES, ConrodParams, CrankshaftParams, length_fields
 
 #: Relative clearance kept between neighbouring features (5 %).
 MARGIN = 1.05
@@ -27,6 +31,51 @@ MARGIN = 1.05
 #: misshapen: the fillets' volume is 0.44-1.9 times the straight-corner closed form (3-5.5 mm:
 #: 0.875-1.01).
 SMALL_END_FILLET_PER_FLANGE = (0.5, 0.9)
+
+
+#: The sizes crankmodal builds, m: every non-zero length of a part (and an imported mesh's extent)
+#: lies in [MIN_LENGTH, MAX_LENGTH]. 1 µm is ten times OpenCASCADE's confusion tolerance (1e-7,
+#: in metres here), below which its solids lose faces; 100 m is beyond any crank-linkage
+#: machine (a marine two-stroke crankshaft is ~25 m). Outside, OpenCASCADE kills the
+#: interpreter (a 1e15 m rod: segmentation fault) or builds nonsense (a 1e-310 m fillet).
+MIN_LENGTH, MAX_LENGTH = 1e-6, 100.0
+
+#: Largest ratio of a part's longest length to its shortest non-zero one. A feature 1e-5 of the
+#: part is a hundred times below the finest mesh the element limit allows on it (5e6
+#: tetrahedra: h of about L / 200), so it cannot change a result, and OpenCASCADE's booleans
+#: are unreliable on solids whose lengths span more decades than its tolerances.
+MAX_LENGTH_RATIO = 1e5
+
+
+class LengthError(ParameterError, GeometryError):
+    """A part length outside the sizes crankmodal builds (:data:`MIN_LENGTH`,
+    :data:`MAX_LENGTH`, :data:`MAX_LENGTH_RATIO`): a ParameterError naming the parameter
+    (``rod.length``) and a GeometryError, raised before any geometry kernel runs."""
+
+
+def check_lengths(part: str, p) -> None:
+    """Refuse a length of ``p`` outside [MIN_LENGTH, MAX_LENGTH] m (0 is allowed: a feature
+    switched off), or lengths spanning more than MAX_LENGTH_RATIO.
+
+    Raises
+    ------
+    LengthError
+        Naming ``<part>.<parameter>``, its value and the admissible sizes.
+    """
+    lengths = {k: v for k, v in length_fields(p).items() if v != 0}
+    for name, v in lengths.items():
+        if not MIN_LENGTH <= v <= MAX_LENGTH:
+            raise LengthError(f"{part}.{name}", f"must be 0 or in [{MIN_LENGTH:g}, {MAX_LENGTH:g}] m, "
+                              f"the sizes crankmodal builds (OpenCASCADE fails outside them), "
+                              f"got {v:.6g}")
+    if lengths:
+        small = min(lengths, key=lengths.get)
+        large = max(lengths, key=lengths.get)
+        if lengths[large] > MAX_LENGTH_RATIO * lengths[small]:
+            raise LengthError(f"{part}.{small}", f"must be 0 or >= {lengths[large] / MAX_LENGTH_RATIO:.6g} m: "
+                              f"at most {MAX_LENGTH_RATIO:.0e} times smaller than {large} = "
+                              f"{lengths[large]:g} m (a finer feature than any mesh of the part "
+                              f"resolves), got {lengths[small]!r}")
 
 
 def _refuse(part: str, name: str, rule: str, value) -> GeometryError:
@@ -159,6 +208,7 @@ def check_crankshaft(p: CrankshaftParams) -> CrankshaftParams:
         _at_most(c, "keyway_depth", p.keyway_depth, 0.4 * rs, "at most 40 % of the stub radius")
         _at_most(c, "keyway_length", p.keyway_length, (p.free_end_length - 2 * p.journal_chamfer) / MARGIN,
                  "within the free-end stub, clear of its chamfers")
+    check_lengths(c, p)
     return p
 
 
@@ -214,4 +264,5 @@ def check_conrod(p: ConrodParams) -> ConrodParams:
                  "the bolt hole must stay inside the boss")
         _at_most(c, "bolt_diameter", p.bolt_diameter, min(0.8 * p.big_end_width, 0.8 * p.bolt_boss_width),
                  "the bolt hole fits the boss")
+    check_lengths(c, p)
     return p

@@ -67,6 +67,8 @@ def import_cad(path, specs: list, settings: MeshSettings) -> Part:
         volumes = [t for _, t in gmsh.model.getEntities(3)]
         if not volumes:
             raise GeometryError(f"geometry.file: {path.name} holds no solid")
+        box = np.asarray(gmsh.model.getBoundingBox(-1, -1), float)
+        check_extent(path.name, float(np.max(box[3:] - box[:3])))
         cad = cad_mass_properties(gmsh, volumes)
         mesh, regions, stats = mesh_tagged(gmsh, volumes, specs, settings)
     try:
@@ -140,6 +142,27 @@ def check_cells_and_points(name: str, cells: np.ndarray, points) -> None:
                              f"{np.array2string(points[i].astype(float), separator=', ')} "
                              f"({int((~finite).sum())} such points); every coordinate must be a "
                              f"finite number (m)")
+    check_extent(name, np.ptp(points[used].astype(float), axis=0).max())
+
+
+def check_extent(name: str, extent: float) -> None:
+    """Refuse a part whose largest extent is outside the sizes crankmodal builds
+    (:data:`~crankmodal.geometry.checks.MIN_LENGTH` to ``MAX_LENGTH``): coordinates are metres,
+    and a mesh scaled far outside them fails as overflow or as "inverted elements".
+
+    Raises
+    ------
+    InputFileError
+        Naming the file and its extent.
+    """
+    from .checks import MAX_LENGTH, MIN_LENGTH
+
+    if not MIN_LENGTH <= extent <= MAX_LENGTH:
+        hint = (" (a mesh in millimetres: scale it by 0.001)" if 1e-1 < extent / 1e3 <= MAX_LENGTH
+                else "")
+        raise InputFileError(f"geometry.file: {name} spans {extent:.6g} m; coordinates are read "
+                             f"in metres and crankmodal builds parts of {MIN_LENGTH:g} to "
+                             f"{MAX_LENGTH:g} m{hint}")
 
 
 def import_mesh(path, specs: list = ()) -> Part:

@@ -89,7 +89,9 @@ def estimate_elements(volume: float, area: float, size: float) -> float:
     float
         ``8.5 V / h^3 + 17.5 A / h^2`` (see :data:`ELEMENTS_PER_VOLUME`).
     """
-    return ELEMENTS_PER_VOLUME * volume / size**3 + ELEMENTS_PER_AREA * area / size**2
+    # divided one power at a time: a subnormal size gives inf, not a ZeroDivisionError, and a
+    # huge one 0, not an OverflowError
+    return ELEMENTS_PER_VOLUME * (volume / size / size / size) + ELEMENTS_PER_AREA * (area / size / size)
 
 
 def size_for_elements(volume: float, area: float, n_elements: float) -> float:
@@ -141,7 +143,9 @@ class MeshSizeError(ParameterError, ResourceError):
         if self.feature:
             dims = ", ".join(f"{prefix}{k} = {x:g} m" for k, x in self.dims.items())
             most = f", most of it the {self.feature}: {dims}"
-        return (f"{self.size:g} m{verb} {self.bound} {self.count:.2g} tetrahedra ({self.basis}"
+        # a subnormal size makes an infinite estimate
+        count = f"{self.bound} {self.count:.2g}" if self.count < float("inf") else "more than 1e308"
+        return (f"{self.size:g} m{verb} {count} tetrahedra ({self.basis}"
                 f"{most}), over the limit of {self.limit:.2g} ({self.reason}); use "
                 f"{size_name} >= {self.smallest:.2g} m")
 
@@ -235,7 +239,8 @@ def check_size_floor(params, settings: MeshSettings) -> float:
     """
     terms = volume_floor_terms(params)
     v = sum(t[1] for t in terms)
-    n = ELEMENTS_PER_VOLUME_FLOOR * v / settings.size**3
+    h = settings.size
+    n = ELEMENTS_PER_VOLUME_FLOOR * (v / h / h / h)  # see estimate_elements: no pow overflow
     if n > settings.max_elements:
         feature, _, keys = max(terms, key=lambda t: t[1])
         h_min = (ELEMENTS_PER_VOLUME_FLOOR * v / settings.max_elements) ** (1.0 / 3.0)

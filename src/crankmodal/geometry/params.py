@@ -179,6 +179,12 @@ class ConrodParams:
 PART_TYPES = {"crankshaft": CrankshaftParams, "rod": ConrodParams}
 
 
+def length_fields(params) -> dict:
+    """The lengths (m) of a parameter set: every float field but the angles (``*_deg``)."""
+    return {f.name: getattr(params, f.name) for f in dataclasses.fields(params)
+            if isinstance(f.default, float) and not f.name.endswith("_deg")}
+
+
 def params_from_dict(part: str, table: dict, where: str = "") -> CrankshaftParams | ConrodParams:
     """Build a parameter set from a TOML-like table, refusing unknown keys and wrong types.
 

@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import json
 import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -96,44 +97,260 @@ def save_flexbody(path, body: FlexibleBody) -> Path:
     return path
 
 
+#: Highest natural frequency a file may hold, Hz: the highest mode of a steel tetrahedron of
+#: 10 µm (the smallest length crankmodal meshes is 1 µm; wave speed / edge = 5e8 Hz) is below it,
+#: so a frequency above it is a damaged file, not a part.
+MAX_FREQUENCY_HZ = 1e9
+
+#: The members every file holds (the optional ones are checked when present).
+REQUIRED = ("format", "version", "name", *_ARRAYS, "interface_names", "interface_kinds",
+            "n_fixed_interface_modes", "mass_kg", "n_full_dofs", "info_json",
+            *(f"I{i}" for i in range(1, 10)))
+
+
+class FlexbodyFileError(InputFileError):
+    """A flexbody file that cannot be trusted: unreadable, not a flexbody, or a member of the
+    wrong kind, shape or value. The message names the file and the member.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    member : str
+        The offending member (``""``: the file as a whole).
+    text : str
+        What is wrong with it.
+    """
+
+    def __init__(self, path, member: str = "", text: str | None = None):
+        if text is None:  # one argument: a message re-raised under a scene key, as it is
+            self.path, self.member, self.text = "", member, str(path)
+            super().__init__(str(path))
+            return
+        self.path, self.member, self.text = str(path), member, text
+        where = f"{path}: member {member!r}" if member else str(path)
+        super().__init__(f"{where}: {text}")
+
+    def __reduce__(self):  # picklable (a study's worker raises it in another process)
+        return type(self), (self.path, self.member, self.text)
+
+
+class _Members:
+    """Checked reads of the members of an open ``.npz`` (every failure a FlexbodyFileError)."""
+
+    def __init__(self, path: Path, z):
+        self.path, self.z = path, z
+
+    def fail(self, name: str, text: str) -> FlexbodyFileError:
+        return FlexbodyFileError(self.path, name, text)
+
+    def has(self, name: str) -> bool:
+        return name in self.z.files
+
+    def raw(self, name: str) -> np.ndarray:
+        if name not in self.z.files:
+            raise self.fail(name, f"missing (every {FORMAT} file has it)")
+        try:
+            return self.z[name]
+        except ValueError as exc:
+            if "allow_pickle" in str(exc) or "pickled" in str(exc):
+                raise self.fail(name, "holds pickled Python objects; crankmodal never unpickles "
+                                "a file (numbers and text only)") from None
+            raise self.fail(name, f"unreadable ({exc})") from None
+        except (OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+            raise self.fail(name, f"unreadable, the file is damaged ({exc})") from None
+
+    def text(self, name: str, choices=None) -> str:
+        a = self.raw(name)
+        if a.ndim != 0 or a.dtype.kind != "U":
+            raise self.fail(name, f"must be a text, got {_kind(a)}")
+        if choices is not None and str(a) not in choices:
+            raise self.fail(name, f"must be one of {', '.join(choices)}, got {str(a)!r}")
+        return str(a)
+
+    def texts(self, name: str, n: int) -> list[str]:
+        a = self.raw(name)
+        if a.shape != (n,) or (n and a.dtype.kind != "U"):
+            raise self.fail(name, f"must be {n} texts, got {_kind(a)}")
+        return [str(s) for s in a]
+
+    def integer(self, name: str, lo: int, hi: float = np.inf) -> int:
+        a = self.raw(name)
+        if a.ndim != 0 or a.dtype.kind not in "iu":
+            raise self.fail(name, f"must be an integer, got {_kind(a)}")
+        if not lo <= int(a) <= hi:
+            raise self.fail(name, f"must be in [{lo}, {hi:g}], got {int(a)}")
+        return int(a)
+
+    def numbers(self, name: str, shape: tuple, nan_ok: bool = False, lo: float | None = None,
+                hi: float | None = None, dtype=float) -> np.ndarray:
+        """A real array of ``shape`` (None: any length), finite (NaN too with ``nan_ok``),
+        within ``[lo, hi]``."""
+        a = self.raw(name)
+        if a.dtype.kind not in "fiu" or a.ndim != len(shape) or any(
+                s is not None and s != t for s, t in zip(shape, a.shape)):
+            raise self.fail(name, f"must be real numbers of shape {_shape(shape)}, got {_kind(a)}")
+        bad = ~np.isfinite(a) & ~(np.isnan(a) if nan_ok else False)
+        if np.any(bad):
+            raise self.fail(name, f"holds a non-finite value {_at(a, bad)} ({int(bad.sum())} "
+                            "such values)")
+        for side, bound, out in ((">=", lo, None if lo is None else a < lo),
+                                 ("<=", hi, None if hi is None else a > hi)):
+            if out is not None and np.any(out):
+                raise self.fail(name, f"must be {side} {bound:g}, got {_at(a, out)}")
+        return a.astype(dtype, copy=False)
+
+    def indices(self, name: str, shape: tuple, below: int) -> np.ndarray:
+        a = self.raw(name)
+        if a.dtype.kind not in "iu" or a.ndim != len(shape) or any(
+                s is not None and s != t for s, t in zip(shape, a.shape)):
+            raise self.fail(name, f"must be integers of shape {_shape(shape)}, got {_kind(a)}")
+        if a.size and (a.min() < 0 or a.max() >= below):
+            raise self.fail(name, f"must index 0 to {below - 1}, got {int(a.min())} to "
+                            f"{int(a.max())}")
+        return a
+
+
+def _kind(a: np.ndarray) -> str:
+    return f"{a.dtype} of shape {a.shape}"
+
+
+def _shape(shape: tuple) -> str:
+    return "(" + ", ".join("any" if s is None else str(s) for s in shape) + (",)" if len(shape) == 1 else ")")
+
+
+def _at(a: np.ndarray, mask: np.ndarray) -> str:
+    """The first value of ``a`` where ``mask``, and its index."""
+    if a.ndim == 0:
+        return f"{float(a):g}"
+    i = np.unravel_index(int(np.argmax(mask)), a.shape)
+    return f"{float(a[i]):g} at {list(map(int, i))}"
+
+
+def _open(path: Path):
+    """The NpzFile at ``path``, or a FlexbodyFileError saying why it is not one."""
+    if not path.is_file():
+        raise InputFileError(f"flexible body file not found: {path}")
+    with open(path, "rb") as fh:
+        head = fh.read(4)
+    if head[:2] != b"PK":  # np.load would try it as a pickle or a bare .npy
+        what = "it is empty" if not head else f"not a zip archive: it starts with {head!r}"
+        raise FlexbodyFileError(path, "", f"not a readable .npz file ({what})")
+    try:
+        z = np.load(path, allow_pickle=False)
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+        raise FlexbodyFileError(path, "", f"not a readable .npz file ({exc})") from None
+    return z
+
+
 def load_flexbody(path) -> FlexibleBody:
-    """Read a body written by :func:`save_flexbody`.
+    """Read a body written by :func:`save_flexbody`, validating every member.
+
+    The file is untrusted: each member is checked for its kind (text, integer, real numbers;
+    never pickled objects), its shape against the body's ``n`` modes, ``m`` interfaces and ``p``
+    mesh points, finiteness (NaN only in ``interface_axes``), and its physical range: natural
+    frequencies in ``[0, MAX_FREQUENCY_HZ]``, positive mass, modal masses and ``I1``, mesh and
+    interface indices inside the mesh, ``info_json`` a JSON object.
 
     Raises
     ------
     InputFileError
-        Missing file, or not a ``crankmodal-flexbody`` file of a known version.
+        Missing file.
+    FlexbodyFileError
+        (an InputFileError) naming the file and the member: unreadable or damaged file, not a
+        ``crankmodal-flexbody`` file of a known version, or a member that is missing, of the
+        wrong kind or shape, non-finite, or out of its physical range.
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputFileError(f"flexible body file not found: {path}")
-    try:
-        z = np.load(path, allow_pickle=False)
-    except (OSError, ValueError, zipfile.BadZipFile) as exc:
-        raise InputFileError(f"{path}: not a readable .npz file ({exc})") from None
+    z = _open(path)
     with z:
-        if "format" not in z.files or str(z["format"]) != FORMAT:
-            raise InputFileError(f"{path}: not a {FORMAT} file")
-        if int(z["version"]) != VERSION:
-            raise InputFileError(f"{path}: {FORMAT} version {int(z['version'])}; "
-                                 f"this crankmodal reads version {VERSION}")
-        kw = {k: z[k] for k in _ARRAYS}
-        return FlexibleBody(
-            name=str(z["name"]), interface_names=[str(s) for s in z["interface_names"]],
-            interface_kinds=[str(s) for s in z["interface_kinds"]],
-            n_fixed_interface_modes=int(z["n_fixed_interface_modes"]),
-            mass_kg=float(z["mass_kg"]), n_full_dofs=int(z["n_full_dofs"]),
-            invariants={f"I{i}": (float(z[f"I{i}"]) if i == 1 else z[f"I{i}"])
-                        for i in range(1, 10)},
-            stress_modes=z["stress_modes"] if "stress_modes" in z.files else None,
-            stress_points=z["stress_points"] if "stress_points" in z.files else None,
-            mesh_points=z["mesh_points"] if "mode_shapes" in z.files else None,
-            mesh_cells=z["mesh_cells"] if "mode_shapes" in z.files else None,
-            mesh_cell_type=str(z["mesh_cell_type"]) if "mode_shapes" in z.files else None,
-            mode_shapes=z["mode_shapes"] if "mode_shapes" in z.files else None,
-            interface_nodes=(np.split(z["interface_nodes"], np.cumsum(z["interface_node_counts"])[:-1])
-                             if "interface_nodes" in z.files else None),
-            interface_weights=(np.split(z["interface_weights"],
-                                        np.cumsum(z["interface_node_counts"])[:-1])
-                               if "interface_weights" in z.files else None),
-            info=json.loads(str(z["info_json"])), **kw)
+        r = _Members(path, z)
+        if not r.has("format") or r.raw("format").dtype.kind != "U" or str(r.raw("format")) != FORMAT:
+            raise FlexbodyFileError(path, "", f"not a {FORMAT} file (no member 'format' = {FORMAT!r})")
+        version = r.integer("version", 0)
+        if version != VERSION:
+            raise FlexbodyFileError(path, "version", f"{FORMAT} version {version}; this "
+                                    f"crankmodal reads version {VERSION}")
+        return FlexibleBody(**_members(r))
+
+
+def _members(r: _Members) -> dict:
+    """The FlexibleBody keywords of a validated file."""
+    f = r.numbers("frequencies_hz", (None,), lo=0.0, hi=MAX_FREQUENCY_HZ)
+    n = len(f)
+    if n == 0:
+        raise r.fail("frequencies_hz", "holds no mode")
+    rigid = r.raw("rigid")
+    if rigid.dtype != bool or rigid.shape != (n,):
+        raise r.fail("rigid", f"must be {n} booleans (one per mode), got {_kind(rigid)}")
+    ne = int((~rigid).sum())
+    names = r.texts("interface_names", len(r.raw("interface_names")))
+    m = len(names)
+    if len(set(names)) != m:
+        raise r.fail("interface_names", f"names an interface twice: {names}")
+    kw = {"name": r.text("name"), "frequencies_hz": f, "rigid": rigid,
+          "interface_names": names}
+    kinds = r.texts("interface_kinds", m)
+    bad = [k for k in kinds if k not in ("rigid", "distributing")]
+    if bad:
+        raise r.fail("interface_kinds", f"must be rigid or distributing, got {bad[0]!r}")
+    kw["interface_kinds"] = kinds
+    for name in ("stiffness", "cb_stiffness", "cb_mass", "cb_to_modal"):
+        kw[name] = r.numbers(name, (n, n))
+    kw["mass"] = r.numbers("mass", (n, n))
+    if not np.all(np.diag(kw["mass"]) > 0):
+        raise r.fail("mass", "modal masses (its diagonal) must be > 0")
+    kw["interface_centres"] = r.numbers("interface_centres", (m, 3))
+    kw["interface_axes"] = r.numbers("interface_axes", (m, 3), nan_ok=True)
+    kw["interface_map"] = r.numbers("interface_map", (m, 6, n))
+    k = r.integer("n_fixed_interface_modes", 0, n)
+    kw["n_fixed_interface_modes"] = k
+    kw["fixed_interface_hz"] = r.numbers("fixed_interface_hz", (k,), lo=0.0, hi=MAX_FREQUENCY_HZ)
+    kw["mass_kg"] = float(r.numbers("mass_kg", ()))
+    if not kw["mass_kg"] > 0:
+        raise r.fail("mass_kg", f"must be > 0 kg, got {kw['mass_kg']:g}")
+    kw["centre_of_mass"] = r.numbers("centre_of_mass", (3,))
+    kw["inertia"] = r.numbers("inertia", (3, 3))
+    kw["n_full_dofs"] = r.integer("n_full_dofs", 1)
+    shapes = {"I1": (), "I2": (3,), "I3": (3, ne), "I4": (3, ne), "I5": (3, ne, ne),
+              "I6": (ne, ne), "I7": (3, 3), "I8": (3, 3, ne), "I9": (3, 3, ne, ne)}
+    inv = {name: r.numbers(name, shape) for name, shape in shapes.items()}
+    inv["I1"] = float(inv["I1"])
+    if not inv["I1"] > 0:
+        raise r.fail("I1", f"the mass invariant must be > 0 kg, got {inv['I1']:g}")
+    kw["invariants"] = inv
+    try:
+        info = json.loads(r.text("info_json"))
+    except json.JSONDecodeError as exc:
+        raise r.fail("info_json", f"not valid JSON ({exc})") from None
+    if not isinstance(info, dict):
+        raise r.fail("info_json", f"must be a JSON object, got {type(info).__name__}")
+    kw["info"] = info
+    kw.update(_optional_members(r, n, m))
+    return kw
+
+
+def _optional_members(r: _Members, n: int, m: int) -> dict:
+    """The stress modes, and the mesh with its mode shapes and interface nodes, when present."""
+    kw = {}
+    if r.has("stress_modes") or r.has("stress_points"):
+        kw["stress_points"] = r.numbers("stress_points", (None, 3))
+        kw["stress_modes"] = r.numbers("stress_modes", (len(kw["stress_points"]), 6, n),
+                                       dtype=r.raw("stress_modes").dtype)
+    if not r.has("mode_shapes"):
+        return kw
+    pts = r.numbers("mesh_points", (None, 3))
+    p = len(pts)
+    kind = r.text("mesh_cell_type", ("tetra", "tetra10"))
+    kw.update(mesh_points=pts, mesh_cell_type=kind,
+              mesh_cells=r.indices("mesh_cells", (None, 4 if kind == "tetra" else 10), p),
+              mode_shapes=r.numbers("mode_shapes", (p, 3, n), dtype=r.raw("mode_shapes").dtype))
+    if r.has("interface_nodes"):
+        counts = r.indices("interface_node_counts", (m,), p + 1)
+        total = int(counts.sum())
+        nodes = r.indices("interface_nodes", (total,), p)
+        # not >= 0: a curved P2 triangle's corner nodes carry slightly negative areas
+        weights = r.numbers("interface_weights", (total,))
+        cuts = np.cumsum(counts)[:-1]
+        kw.update(interface_nodes=np.split(nodes, cuts), interface_weights=np.split(weights, cuts))
+    return kw
