@@ -211,29 +211,41 @@ def half_peak_to_peak(coefficients: np.ndarray, harmonics: np.ndarray) -> tuple[
     X = np.asarray(coefficients, complex)
     k = np.asarray(harmonics, int)
     kmax = int(k.max())
+    shape = X.shape[:-1]
     n = 1 << max(6, int(math.ceil(math.log2(8 * kmax + 1))))
     phi = 2 * math.pi * np.arange(n) / n
     basis = np.concatenate([np.cos(np.outer(k, phi)), -np.sin(np.outer(k, phi))])
-    x = np.concatenate([X.real, X.imag], axis=-1) @ basis  # samples, (..., n)
+    flat = X.reshape(-1, len(k))
+    x = np.concatenate([flat.real, flat.imag], axis=1) @ basis  # samples, (m, n)
+    Xt = np.ascontiguousarray(flat.T)  # (n_harmonics, m): harmonic axis first, contiguous
     h = 2 * math.pi / n
-    k2 = (k**2).astype(float)
-    kf = k.astype(float)
+    kf = k.astype(float)[:, None]
+    k2 = kf**2
+
+    def waves(p):  # exp(i k p), (n_harmonics, m), by powers of exp(i p) (cheaper than exp)
+        e1 = np.exp(1j * p)
+        pw = np.empty((kmax, len(p)), complex)
+        pw[0] = e1
+        for j in range(1, kmax):
+            np.multiply(pw[j - 1], e1, out=pw[j])
+        return pw if len(k) == kmax else pw[k - 1]
+
+    rows = np.arange(x.shape[0])
     ext = []
-    for sign in (1.0, -1.0):
-        i = np.argmax(sign * x, axis=-1)
-        sampled = np.take_along_axis(x, i[..., None], -1)[..., 0]
+    for sign, i in ((1.0, np.argmax(x, axis=1)), (-1.0, np.argmin(x, axis=1))):
+        sampled = x[rows, i]
         p0 = phi[i]
         p = p0
         for _ in range(3):
-            xe = X * np.exp(1j * p[..., None] * kf)
-            d1 = -(xe.imag @ kf)
-            d2 = -(xe.real @ k2)
+            xe = Xt * waves(p)
+            d1 = -(xe.imag * kf).sum(0)
+            d2 = -(xe.real * k2).sum(0)
             ok = sign * d2 < 0
             step = np.where(ok, -d1 / np.where(ok, d2, 1.0), 0.0)
             p = np.where(np.abs(p + step - p0) <= h, p + step, p)
-        val = (X * np.exp(1j * p[..., None] * kf)).real.sum(-1)
+        val = (Xt * waves(p)).real.sum(0)
         better = sign * val >= sign * sampled
-        ext.append((np.where(better, val, sampled), np.where(better, p, p0)))
+        ext.append((np.where(better, val, sampled).reshape(shape), np.where(better, p, p0).reshape(shape)))
     return 0.5 * (ext[0][0] - ext[1][0]), ext[0][1]
 
 
