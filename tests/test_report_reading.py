@@ -183,3 +183,17 @@ def test_plot_legends_list_only_curves_that_can_be_seen(monkeypatch, tmp_path):
     # the crank torque's axis says its sign
     ylabel = figs["mechanism_crank_torque.png"].axes[0].get_ylabel()
     assert "on the crankshaft" in ylabel and "+ in the sense of rotation" in ylabel
+
+
+def test_cancelled_forces_of_the_four_star_read_zero_not_piconewtons(mech_report):
+    """Four-star balance (seed 000, Table 1): the 2nd-order forces of the four cylinders cancel
+    and the counterweight takes the constant 1st-order resultant, so both compute to round-off
+    (~1e-13 N) and the table says 0, against a 1st-order force of m_s r omega^2 per pair."""
+    out, res = mech_report
+    m = res["mechanism"]
+    assert m["second_order_force_max_n"] < 1e-9 * m["first_order_force_max_n"]
+    sec = _text(_section((out / "report.html").read_text(), "[mechanism]"))
+    for label in ("2nd-order force, max", "1st-order residual with counterweight",
+                  "shaking force with counterweight, max"):
+        assert re.search(rf"{re.escape(label)}\s+0 N \(round-off\)", sec), label
+    assert "pN" not in sec and "× 10⁻¹" not in sec

@@ -68,7 +68,8 @@ class Report:
                 out.append("<table><thead><tr>" + "".join(f"<th>{html.escape(str(h))}</th>"
                                                           for h in b[1]) + "</tr></thead><tbody>")
                 for r in b[2]:
-                    out.append("<tr>" + "".join(_html_cell(_cell(c)) for c in r) + "</tr>")
+                    out.append("<tr>" + "".join(_html_cell(_cell(c), first=k == 0)
+                                                for k, c in enumerate(r)) + "</tr>")
                 out.append("</tbody></table>")
             elif b[0] == "img":
                 mime = _MIME.get(b[1].suffix.lower(), "application/octet-stream")
@@ -112,13 +113,17 @@ def _cell(c) -> str:
     return str(c)
 
 
-#: a cell that starts with a number (right-aligned in HTML, so the digits line up)
+#: a short cell that starts with a number: a value, right-aligned in HTML so digits line up
+#: (a sentence such as a summary starting with "4 cyl at ..." stays left-aligned and wraps)
 _NUMERIC = re.compile(r"^[-+−±<>≈]?\s?\d")
+_NUMERIC_MAX_CHARS = 32
 
 
-def _html_cell(text: str) -> str:
-    """``<td>`` of a cell's text, escaped for HTML; numbers right-aligned, words left."""
-    cls = ' class="n"' if _NUMERIC.match(text) else ""
+def _html_cell(text: str, first: bool = False) -> str:
+    """``<td>`` of a cell's text, escaped for HTML; values right-aligned, words (and the first
+    column, which names the row: ``1st-order force``) left."""
+    numeric = not first and len(text) <= _NUMERIC_MAX_CHARS and _NUMERIC.match(text)
+    cls = ' class="n"' if numeric else ""
     return f"<td{cls}>{html.escape(text)}</td>"
 
 

@@ -133,12 +133,31 @@ def subsections(report: Report, res: dict, out_dir: Path, shown: list[Path]) -> 
 SUBTITLES = {"flexible": "Flexible vs rigid"}
 
 
-def _rows(res: dict, spec) -> list[list]:
-    """Table rows ``[label, formatted value]`` for the keys of ``spec`` present in ``res``."""
+#: a force or moment below this fraction of the table's largest is round-off of a cancellation
+ROUND_OFF = 1e-9
+
+
+def _rows(res: dict, spec, round_off: bool = False) -> list[list]:
+    """Table rows ``[label, formatted value]`` for the keys of ``spec`` present in ``res``.
+
+    With ``round_off``, a scalar below :data:`ROUND_OFF` of the largest value of the same unit
+    in the table prints as ``0 N (round-off)``: a cancelled order or a fully balanced force
+    computes to 1e-13 N, which is zero, not a force in piconewtons."""
+    top: dict = {}
+    for key, _, unit, scale in spec:
+        v = res.get(key)
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            top[unit] = max(top.get(unit, 0.0), abs(v * scale))
     rows = []
     for key, label, unit, scale in spec:
-        if res.get(key) is not None:
-            rows.append([label, fmt(res[key], unit, scale)])
+        v = res.get(key)
+        if v is None:
+            continue
+        if (round_off and isinstance(v, float) and top.get(unit, 0.0) > 0
+                and abs(v * scale) <= ROUND_OFF * top[unit]):
+            rows.append([label, f"0 {unit} (round-off)"])
+        else:
+            rows.append([label, fmt(v, unit, scale)])
     return rows
 
 
@@ -209,7 +228,7 @@ def mechanism_blocks(report: Report, res: dict) -> None:
     forces and crank torque of one working cycle."""
     for name, spec in (("Kinematics", MECHANISM_KINEMATICS), ("Balance", MECHANISM_BALANCE),
                        ("Forces and crank torque", MECHANISM_FORCES)):
-        rows = _rows(res, spec)
+        rows = _rows(res, spec, round_off=spec is MECHANISM_BALANCE)
         if rows:
             report.heading(name, level=3)
             report.table(["quantity", "value"], rows)
