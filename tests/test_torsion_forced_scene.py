@@ -80,9 +80,15 @@ def test_same_train_as_opentorsion_same_frequencies_and_steady_state(oracle):
     assert err <= 1e-4
 
 
-def test_seed004_train_study_writes_contract_fields_and_figures(tmp_path):
-    p = run_cli("run", SEED, "--out", tmp_path)
-    assert p.returncode == 0, p.stderr
+def test_seed004_train_study_writes_contract_fields_figures_and_report(tmp_path):
+    import tomllib
+
+    from crankmodal.runner import run
+    from crankmodal.scene import scene_from_dict
+
+    data = tomllib.loads(SEED.read_text())
+    data["report"] = {}
+    run(scene_from_dict(data, name="seed004_forced", base_dir=SEED.parent), tmp_path, figures=True)
     t = json.loads((tmp_path / "results.json").read_text())["torsion"]
     f = t["forced"]
     n_s = len(f["speed_rpm"])
@@ -101,6 +107,11 @@ def test_seed004_train_study_writes_contract_fields_and_figures(tmp_path):
     for name in ("torsion_forced_interference.png", "torsion_forced_response.png",
                  "torsion_forced_stress.png", "torsion_forced_resonances.txt"):
         assert (tmp_path / name).stat().st_size > 0
+    # the report's torsion section: verdict, section stresses, margins and the three figures
+    md = (tmp_path / "report.md").read_text()
+    assert "Forced response, stress and verdict" in md and "of allowable" in md
+    for name in ("torsion_forced_interference", "torsion_forced_response", "torsion_forced_stress"):
+        assert name in md
 
 
 @pytest.mark.parametrize("override, key", [

@@ -246,6 +246,10 @@ def torsion_blocks(report: Report, res: dict) -> None:
                      [[k + 1, fmt(f), fmt(hz[k]) if k < len(hz) else None,
                        fmt(two) if k == 0 and two is not None else None]
                       for k, f in enumerate(ex)])
+    if res.get("forced"):  # issue 28: the forced study's own tables (torsion/forced_report.py)
+        from ..torsion.forced_report import forced_blocks
+
+        forced_blocks(report, res["forced"])
     crit = res.get("critical_speeds")
     if not crit:
         return
