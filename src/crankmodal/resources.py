@@ -29,7 +29,19 @@ def _dirs(kind: str) -> list[Path]:
 
 
 def list_machines() -> list[str]:
-    """Names of the machine parameter files found, sorted."""
+    """Names of the machine parameter files found, sorted.
+
+    Returns
+    -------
+    list of str
+        Names for ``machine = "..."`` in a scene and for :func:`load_machine`.
+
+    Examples
+    --------
+    >>> import crankmodal as cm
+    >>> "four_star_compressor" in cm.list_machines()
+    True
+    """
     names = {p.stem for d in _dirs("geometry") for p in d.glob("*.toml")}
     return sorted(names)
 
@@ -98,8 +110,20 @@ def decode_utf8(raw: bytes, path) -> str:
 
 
 def load_machine(name: str, key: str = "machine") -> dict:
-    """The parameter tables of machine ``name`` (SI units), as a dict of tables; ``key`` is the
-    scene key naming it, for the error message.
+    """The parameter tables of machine ``name`` (SI units), as a dict of tables.
+
+    Parameters
+    ----------
+    name : str
+        A machine of :func:`list_machines` (``geometry/<name>.toml``, or a folder on
+        ``CRANKMODAL_MACHINES``).
+    key : str
+        The scene key naming it, for the error message.
+
+    Returns
+    -------
+    dict
+        One table per section or part (``mechanism``, ``crankshaft``, ``rod``, ...).
 
     Examples
     --------
@@ -111,7 +135,23 @@ def load_machine(name: str, key: str = "machine") -> dict:
 
 
 def scene_path(name: str) -> Path:
-    """Path of a ready scene shipped with crankmodal (``scenes/<name>.toml``)."""
+    """Path of a ready scene shipped with crankmodal (``scenes/<name>.toml``).
+
+    Parameters
+    ----------
+    name : str
+        The scene's file stem, e.g. ``four_star_compressor`` (the main job).
+
+    Returns
+    -------
+    Path
+
+    Examples
+    --------
+    >>> import crankmodal as cm
+    >>> cm.scene_path("four_star_compressor").name
+    'four_star_compressor.toml'
+    """
     for d in _dirs("scenes"):
         p = d / f"{name}.toml"
         if p.is_file():

@@ -94,12 +94,33 @@ def _check_scene(scene) -> Scene:
 def check(scene: Scene) -> dict[str, dict]:
     """Validate every section without running anything; returns the parameters per section.
 
+    Parameters
+    ----------
+    scene : Scene
+        From :func:`load_scene`, :func:`scene_from_dict` or :func:`scene_path`.
+
+    Returns
+    -------
+    dict
+        Section name -> its validated parameters (defaults filled in, SI units).
+
     Raises
     ------
     ParameterError
         ``scene`` is not a :class:`~crankmodal.scene.Scene`.
     SceneError
         A scene key is unknown, of the wrong type, or out of its range.
+
+    Examples
+    --------
+    >>> import crankmodal as cm
+    >>> scene = cm.scene_from_dict({"mechanism": {"machine": "four_star_compressor"}})
+    >>> cm.check_scene(scene)["mechanism"]["speed_rpm"]
+    1480.0
+    >>> cm.check_scene(cm.scene_from_dict({"mechanism": {"speed_rpm": -5.0}}))
+    Traceback (most recent call last):
+    ...
+    crankmodal.errors.SceneError: mechanism.speed_rpm: must be > 0, got -5.0
     """
     _check_scene(scene)
     return {s: stage_module(s).validate(scene.sections[s], scene) for s in plan(scene)}

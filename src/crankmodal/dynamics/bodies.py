@@ -123,7 +123,18 @@ class RigidBody:
 
 @dataclass
 class Ground:
-    """The fixed frame: no coordinates, frames at fixed global poses."""
+    """The fixed frame: no coordinates, frames at fixed global poses.
+
+    Parameters
+    ----------
+    name : str
+        Its name in the mechanism.
+    frames : dict
+        Frame name -> fixed global pose ``(x, y)`` in m, or ``(x, y, angle)`` with the angle in
+        rad (where joints attach to the ground).
+    z : float
+        Axial position (m) of the body's plane, as for the other bodies.
+    """
 
     name: str = "ground"
     frames: dict = field(default_factory=dict)

@@ -18,6 +18,15 @@ class Revolute:
     """Pin between frame ``frame_a`` of body ``a`` and ``frame_b`` of body ``b`` (2 equations).
 
     The multiplier ``lam`` (N) is the force that body ``a`` exerts on body ``b``.
+
+    Parameters
+    ----------
+    name : str
+        The joint's name (its forces are reported under it).
+    a, b : body
+        A :class:`RigidBody`, :class:`FlexibleBody` or :class:`Ground`.
+    frame_a, frame_b : str
+        Names of the frames (interfaces) of ``a`` and ``b`` that the pin joins.
     """
 
     name: str
@@ -42,6 +51,21 @@ class Prismatic:
     The line passes through ``origin`` (m) with unit direction ``axis``; the slider keeps the
     orientation ``angle`` (rad). Multipliers: the force (N) across the line the slider exerts on
     the guide, and the moment (N m) it exerts on the guide.
+
+    Parameters
+    ----------
+    name : str
+        The joint's name.
+    a : body
+        The sliding body (a piston).
+    frame_a : str
+        Its frame on the line.
+    origin : array_like, shape (2,)
+        A point of the line, m.
+    axis : array_like, shape (2,)
+        The line's unit direction.
+    angle : float
+        The orientation the slider keeps, rad.
     """
 
     name: str

@@ -519,5 +519,33 @@ FRICTION: dict[str, type[FrictionLaw]] = {c.name: c for c in (NoFriction, Coulom
 
 
 def make_friction(name: str, params=None) -> FrictionLaw:
-    """A friction law from its name and a ``friction_params`` mapping (unused keys ignored)."""
+    """A friction law from its name and a ``friction_params`` mapping (unused keys ignored).
+
+    Parameters
+    ----------
+    name : str
+        ``none``, ``coulomb`` (static/dynamic transition) or ``ambrosio``.
+    params : mapping, optional
+        Its parameters: ``mu_static``, ``mu_dynamic`` (-), ``v_static``, ``v_dynamic`` (m/s), ...
+
+    Returns
+    -------
+    FrictionLaw
+        ``coefficient(v)`` is the signed coefficient at slip velocity ``v`` (m/s).
+
+    Raises
+    ------
+    ValueError
+        Unknown name, a missing parameter, or an invalid value (naming it).
+
+    Examples
+    --------
+    Past the transition velocity Coulomb friction is the dynamic coefficient:
+
+    >>> import crankmodal as cm
+    >>> law = cm.make_friction("coulomb", {"mu_static": 0.2, "mu_dynamic": 0.1,
+    ...                                    "v_static": 1e-4, "v_dynamic": 1e-2})
+    >>> float(law.coefficient(1.0))
+    0.1
+    """
     return _build(FRICTION, "friction", name, params)

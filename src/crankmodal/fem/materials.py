@@ -108,6 +108,23 @@ def library() -> dict[str, dict]:
 def material(name: str) -> Material:
     """A material of the library by name (case-insensitive).
 
+    Parameters
+    ----------
+    name : str
+        A name of the library (``steel``, ``42CrMo``, ...).
+
+    Returns
+    -------
+    Material
+        E and the strengths in Pa, rho in kg/m^3.
+
+    Examples
+    --------
+    >>> import crankmodal as cm
+    >>> steel = cm.material("Steel")
+    >>> steel.E, steel.nu, steel.rho
+    (210000000000.0, 0.3, 7850.0)
+
     Raises
     ------
     ParameterError
