@@ -182,7 +182,7 @@ def mode_rows(modal: dict, effective_mass: bool = True) -> list[list]:
         rows.append([k + 1, f"{f[k]:.2f}", classes[k]]
                     + ([fmt(em[c][k]) if c in em else None for c in EFFECTIVE_MASS_KEYS]
                        if effective_mass else [])
-                    + [f"{res[k]:.1e}" if res[k] is not None else None])
+                    + [number(res[k], 2) if res[k] is not None else None])
     return rows
 
 
@@ -274,8 +274,9 @@ def modal_blocks(report: Report, *, geometry: dict, material: dict, modal: dict,
               f"No effective-mass columns: the part is free-free, and its "
               f"{modal.get('rigid_body_modes')} rigid-body modes carry the whole mass, so every "
               f"elastic mode's effective mass is zero (to round-off).")
-    report.paragraph(f"Largest eigen-residual ‖Kφ − λMφ‖/‖Kφ‖: {modal.get('residual_max', 0):.1e}; "
-                     f"M-orthogonality defect {modal.get('m_orthogonality_max', 0):.1e}. "
+    report.paragraph(f"Largest eigen-residual ‖Kφ − λMφ‖/‖Kφ‖: "
+                     f"{number(modal.get('residual_max', 0), 2)}; M-orthogonality defect "
+                     f"{number(modal.get('m_orthogonality_max', 0), 2)}. "
                      + masses)
     if measured_hz:
         heading("Comparison with measured frequencies")
