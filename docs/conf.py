@@ -35,8 +35,12 @@ extensions = [
     "crankmodal_docs",  # scene reference, validation tables, gallery (generated)
 ]
 
-# no network: no intersphinx, notebooks shown with the outputs they carry
+# no network: no intersphinx. Notebooks are shown with the outputs they carry; the quick ones
+# without outputs are marked for execution by _ext/crankmodal_docs.py (per-notebook metadata)
 nb_execution_mode = "off"
+nb_execution_in_temp = True  # their files go to a temporary folder, not into docs/
+nb_execution_timeout = 900
+nb_execution_raise_on_error = True
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
@@ -51,7 +55,7 @@ numpydoc_validation_checks: set[str] = set()
 numpydoc_xref_param_type = False
 
 exclude_patterns = ["_build", "_ext", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints",
-                    "validation/*.json"]
+                    "validation/*.json", "gallery/executed"]
 templates_path = ["_templates"]
 
 html_theme = "pydata_sphinx_theme"

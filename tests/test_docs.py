@@ -25,7 +25,11 @@ import crankmodal_docs  # noqa: E402
 #: modules whose docstring Examples are executed (the main entry points)
 DOCTEST_MODULES = (
     "crankmodal.scene",
+    "crankmodal.runner",
     "crankmodal.resources",
+    "crankmodal.fem.materials",
+    "crankmodal.fem.assembly",
+    "crankmodal.fem.loads",
     "crankmodal.torsion.chain",
     "crankmodal.torsion.holzer",
     "crankmodal.torsion.two_rotor",
@@ -33,15 +37,18 @@ DOCTEST_MODULES = (
     "crankmodal.fem.modal",
 )
 #: public names that must carry an executed Examples section
-WITH_EXAMPLES = ("scene_from_dict", "load_machine", "TorsionalChain", "exact_modes", "holzer",
-                 "two_rotor", "make_law", "solve_modes")
+WITH_EXAMPLES = ("scene_from_dict", "check_scene", "load_machine", "list_machines", "scene_path",
+                 "material", "mass_properties", "pressure_load", "solve_modes", "TorsionalChain",
+                 "exact_modes", "holzer", "two_rotor", "make_law", "make_friction")
 
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
     """Build the site once (html, warnings as errors, no network); the output folder."""
     out = tmp_path_factory.mktemp("site")
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONWARNINGS="ignore")
+    # the quick notebooks are not executed here (tests/test_notebooks.py runs them; the real build
+    # does, 2-3 min more): the build is checked with their committed or executed-copy outputs
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONWARNINGS="ignore", CRANKMODAL_DOCS_EXECUTE="0")
     # no proxy either: a build that tried the network would fail here, not hang
     env.update(http_proxy="http://0.0.0.0:9", https_proxy="http://0.0.0.0:9")
     proc = subprocess.run(
@@ -194,6 +201,38 @@ def test_readme_is_short_and_links_only_to_files_that_exist():
     # no leftover editing text, and no statement that the reduction does not feed the dynamics
     assert '"' not in "".join(re.findall(r"^#+ .*$", text, re.M))
     assert "not yet used" not in text
+
+
+def test_every_notebook_is_shown_with_its_figures_when_the_site_is_built():
+    """Committed outputs, an executed copy whose code equals the notebook's, or executed at
+    build (quick ones); only the notebooks named here are shown as code only."""
+    code_only = {"seed000_crank_and_flexible", "seed_trends"}  # no executed copy committed yet
+    plan = crankmodal_docs.gallery_plan(execute=True)
+    assert set(plan) == {p.stem for p in (REPO / "notebooks").glob("*.ipynb")}
+    assert {n for n, how in plan.items() if how == "code only"} <= code_only, plan
+    assert plan["walkthrough"] == "committed"
+    # an executed copy whose code no longer matches the notebook is not used
+    for copy in (DOCS / "gallery" / "executed").glob("*.ipynb"):
+        assert plan[copy.stem] == "executed copy", copy.name
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/getting_started.md"])
+def test_the_python_and_toml_examples_of_the_front_pages_run(page, tmp_path, monkeypatch):
+    """The README's and Getting started's Python blocks run as printed (in a temporary folder),
+    and their TOML scenes pass ``check_scene``."""
+    import tomllib
+
+    import crankmodal as cm
+
+    text = (REPO / page).read_text(encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {"__name__": "docs_example"}
+    blocks = re.findall(r"^```python\n(.*?)^```", text, re.DOTALL | re.MULTILINE)
+    assert blocks
+    for i, code in enumerate(blocks):
+        exec(compile(code, f"{page} python block {i + 1}", "exec"), namespace)  # noqa: S102
+    for block in re.findall(r"^```toml\n(.*?)^```", text, re.DOTALL | re.MULTILINE):
+        cm.check_scene(cm.scene_from_dict(tomllib.loads(block), base_dir=REPO / "scenes"))
 
 
 def test_oracle_json_round_trips():

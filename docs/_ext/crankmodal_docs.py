@@ -6,9 +6,11 @@
   suite writes (``CRANKMODAL_ORACLES=docs/validation/oracles.json``, see ``tests/conftest.py``).
 * ``reference/api.md`` -- an autosummary of every name in ``crankmodal.__all__``, grouped by the
   subpackage it comes from, so a newly exported name is documented without editing a page.
-* ``gallery/*.ipynb`` -- copies of ``notebooks/*.ipynb`` (Sphinx reads only its source folder;
-  a copy instead of a symlink works on every file system). The notebooks are shown with the
-  outputs they carry (``nb_execution_mode = "off"``).
+* ``gallery/notebooks/*.ipynb`` -- copies of ``notebooks/*.ipynb`` (Sphinx reads only its source
+  folder; a copy instead of a symlink works on every file system), shown as :func:`gallery_plan`
+  says: with the outputs they carry, from an executed copy committed in ``gallery/executed/``
+  (the slow ones), or executed at build (the quick ones; ``CRANKMODAL_DOCS_EXECUTE=0`` skips
+  that, as ``tests/test_docs.py`` does: ``tests/test_notebooks.py`` runs them).
 
 The generators are pure functions of the repository (``scene_markdown``, ``validation_markdown``)
 so ``tests/test_docs.py`` can check them without building.
@@ -288,16 +290,65 @@ def _write_if_changed(path: Path, text: str) -> None:
         path.write_text(text, encoding="utf-8")
 
 
-def copy_notebooks(dest: Path) -> list[str]:
-    """Copy ``notebooks/*.ipynb`` into ``dest`` (only when changed); return the names."""
+SLOW_MARK = "# crankmodal: slow-notebook"  # as tests/test_notebooks.py
+EXECUTE_ENV = "CRANKMODAL_DOCS_EXECUTE"
+
+
+def _code_cells(nb: dict) -> list[str]:
+    return ["".join(c["source"]).strip() for c in nb["cells"] if c["cell_type"] == "code"]
+
+
+def _has_outputs(nb: dict) -> bool:
+    return any(c.get("outputs") for c in nb["cells"] if c["cell_type"] == "code")
+
+
+def gallery_plan(execute: bool | None = None) -> dict[str, str]:
+    """How each notebook of ``notebooks/`` is shown: ``"committed"`` (it carries its outputs),
+    ``"executed copy"`` (``gallery/executed/NAME.ipynb``, run once and committed, used while its
+    code cells equal the notebook's), ``"execute"`` (a quick notebook, run at build) or
+    ``"code only"`` (a slow one without an executed copy, or quick ones when
+    ``CRANKMODAL_DOCS_EXECUTE=0``)."""
+    import os
+
+    if execute is None:
+        execute = os.environ.get(EXECUTE_ENV, "1") != "0"
+    plan = {}
+    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        nb = json.loads(path.read_text(encoding="utf-8"))
+        copy = DOCS / "gallery" / "executed" / path.name
+        pair = path.with_suffix(".py")
+        slow = pair.exists() and SLOW_MARK in pair.read_text(encoding="utf-8")
+        if _has_outputs(nb):
+            plan[path.stem] = "committed"
+        elif copy.exists() and _code_cells(json.loads(copy.read_text(encoding="utf-8"))) \
+                == _code_cells(nb):
+            plan[path.stem] = "executed copy"
+        elif execute and not slow:
+            plan[path.stem] = "execute"
+        else:
+            plan[path.stem] = "code only"
+    return plan
+
+
+def copy_notebooks(dest: Path, execute: bool | None = None) -> dict[str, str]:
+    """Copy the notebooks into ``dest`` as :func:`gallery_plan` says (only when changed): an
+    executed copy in place of the notebook, a quick one marked for execution at build
+    (myst-nb's per-notebook ``execution_mode``). Returns the plan."""
     dest.mkdir(parents=True, exist_ok=True)
-    names = []
-    for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
-        target = dest / nb.name
-        if not target.exists() or target.read_bytes() != nb.read_bytes():
-            shutil.copyfile(nb, target)
-        names.append(nb.stem)
-    return names
+    plan = gallery_plan(execute)
+    for name, how in plan.items():
+        src = ROOT / "notebooks" / f"{name}.ipynb"
+        if how == "executed copy":
+            src = DOCS / "gallery" / "executed" / f"{name}.ipynb"
+        nb = json.loads(src.read_text(encoding="utf-8"))
+        if how == "execute":
+            nb.setdefault("metadata", {})["mystnb"] = {"execution_mode": "force"}
+        text = json.dumps(nb, indent=1, ensure_ascii=False) + "\n"
+        _write_if_changed(dest / f"{name}.ipynb", text)
+    for stale in dest.glob("*.ipynb"):
+        if stale.stem not in plan:
+            stale.unlink()
+    return plan
 
 
 def generate(app=None) -> None:
