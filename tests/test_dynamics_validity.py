@@ -138,3 +138,8 @@ def test_the_slender_coupler_at_20000_rpm_is_warned_and_at_450_rpm_not(tmp_path)
     assert v["inside"] is True and v["deflection_fraction"] < DEFLECTION_FRACTION
     assert not [w for w in slow["warnings"] if w.startswith("dynamics.flexible.coupler")]
     assert "OUTSIDE" not in slow["summary"]
+    # item 13: the coupler's lowest mode held at its joints, stated in results and summary
+    e = slow["flexible"]["bodies"]["coupler"]["effective_damping"]
+    assert e["pinned"] == ["end_x0", "end_x1"] and e["given_ratio"] == 0.02
+    assert f"coupler {e['frequency_hz']:.4g} Hz held at end_x0, end_x1, effective damping " \
+           f"{e['damping_ratio']:.2g} (0.02 given on its free-free modes)" in slow["summary"]

@@ -245,17 +245,18 @@ def flexible_validity(body, deflection: dict | None, stress: dict | None, key: s
 
 
 def validity_summary(bodies: dict) -> str:
-    """The summary's words on flexible bodies: each one's lowest mode with its joints pinned
-    and its effective damping, and the bodies outside the model's validity.
+    """The summary's words on flexible bodies: each one's lowest mode with its joints held
+    (:func:`.modal_damping.effective_damping`) and its effective damping, and the bodies outside
+    the model's validity.
 
     ``bodies``: results ``dynamics.flexible.bodies`` (``validity``, ``effective_damping``)."""
     parts, bad = [], []
     for name, d in bodies.items():
         e = d.get("effective_damping")
         if e:
-            parts.append(f"{name} {e['frequency_hz']:.4g} Hz with its joints pinned, effective "
-                         f"damping {e['damping_ratio']:.2g} ({e['given_ratio']:g} given on its "
-                         f"free-free modes)")
+            parts.append(f"{name} {e['frequency_hz']:.4g} Hz held at {', '.join(e['pinned'])}, "
+                         f"effective damping {e['damping_ratio']:.2g} ({e['given_ratio']:g} "
+                         f"given on its free-free modes)")
         v = d.get("validity") or {}
         why = []
         if v.get("deflection_fraction") is not None and \
