@@ -214,3 +214,15 @@ def test_each_mode_render_is_shown_once(bar_report, tmp_path):
     assert len(gifs) == 2 and all(pics.count(g) == 1 for g in gifs)
     for name in res["report"]["renders"] + ["mode_sheet.png"]:
         assert (tmp_path / "out" / name).read_bytes() not in pics
+
+
+def test_modal_report_text_has_no_exponent_notation_and_no_escaped_bars(bar_report):
+    """Issue 25 #15, on the FE part's report (mode table residuals, timings, static stress):
+    every number engineering-formatted; pictures and tags left out of the text."""
+    import html as htmlmod
+
+    out, _ = bar_report
+    page = re.sub(r"<img [^>]*>", "", (out / "report.html").read_text())
+    text = htmlmod.unescape(re.sub(r"<[^>]+>", " ", page))
+    assert not re.findall(r"\S*\d[eE][+-]?\d+\S*", text)
+    assert "\\|" not in text
