@@ -88,10 +88,11 @@ RAIMONDI_BOYD = [(0.1, 1.33, 79.5), (0.2, 0.631, 74.02), (0.4, 0.264, 63.10),
 
 
 @pytest.mark.parametrize("eps,S,phi", RAIMONDI_BOYD)
-def test_finite_bearing_at_unit_length_ratio_reproduces_raimondi_boyd(eps, S, phi):
+def test_finite_bearing_at_unit_length_ratio_reproduces_raimondi_boyd(oracle, eps, S, phi):
     # Tolerance 2 % in S and 0.6 deg: the chart's own accuracy (hand relaxation); measured
     # worst 1.3 % and 0.53 deg, both at eps = 0.4, the others within 0.2 % and 0.2 deg.
     b = steady_bearing(eps, 1.0)
+    oracle(stage="dynamics", quantity=f"finite bearing L/D = 1, Sommerfeld number at eps = {eps}", reference="Raimondi-Boyd chart (published)", tolerance="2 %", measured=b.sommerfeld, expected=S)
     assert b.sommerfeld == pytest.approx(S, rel=0.02)
     assert b.attitude_deg == pytest.approx(phi, abs=0.6)
 
@@ -107,11 +108,12 @@ T3_LOAD = np.array([0.197, 0.415, 0.680, 1.029, 1.524, 2.296, 3.654])
 T3_PHI = np.array([75.11, 63.59, 55.55, 50.08, 45.32, 40.54, 36.02])
 
 
-def test_seed_001_table_3_is_a_150_degree_partial_bearing_within_2p5_percent_and_1p5_deg():
+def test_seed_001_table_3_is_a_150_degree_partial_bearing_within_2p5_percent_and_1p5_deg(oracle):
     # coarse 96 x 16 grid (3 s): the arc edges fall on nodes 3.75 deg apart, which moves the
     # load by up to 2 % and the angle by 1.2 deg (192 x 32: 1.1 %, 0.6 deg, slow test below);
     # the table's printed 3-4 digits are finer than that.
     fin = [steady_bearing(e, 1.0, 96, 16, arc_deg=150.0) for e in T3_EPS]
+    oracle(stage="dynamics", quantity="150 deg partial bearing L/D = 1, load number at eps = 0.7", reference="seed 001 Table 3 (published)", tolerance="2.5 %", measured=fin[-1].load, expected=T3_LOAD[-1])
     np.testing.assert_allclose([b.load for b in fin], T3_LOAD, rtol=0.025)
     np.testing.assert_allclose([b.attitude_deg for b in fin], T3_PHI, atol=1.5)
     # the full bearing and the short bearing do not: 11..18 % and 38..164 % off in load
