@@ -103,20 +103,33 @@ def headlines(base_stats: dict, ensemble: dict | None = None) -> dict:
     return out
 
 
-def headline_text(block: dict, n_revolutions: int) -> str:
-    """The summary line's numbers: each quantity once, ``value ± uncertainty (basis)``."""
-    names = {"main_bearing_per_rev_peak_n": "main-bearing per-rev peak",
+def _label(key: str) -> str:
+    """Words for a headline key (``big_end_1_impacts_per_rev`` -> ``big_end_1 impacts/rev``)."""
+    fixed = {"main_bearing_per_rev_peak_n": "main-bearing per-rev peak",
              "main_bearing_rms_n": "main-bearing RMS",
              "piston_per_rev_peak_max_m_s2": "piston accel per-rev peak"}
+    if key in fixed:
+        return fixed[key]
+    for end, words in (("_impacts_per_rev", " impacts/rev"),
+                       ("_impact_velocity_max_per_rev_m_s", " largest impact velocity/rev")):
+        if key.endswith(end):
+            return key[: -len(end)] + words
+    return key
+
+
+def headline_text(block: dict, n_revolutions: int) -> str:
+    """The summary line's numbers: each quantity once, ``value ± uncertainty``, marked
+    ``(spread)`` where the uncertainty is the trajectory-to-trajectory spread."""
     parts = []
     n_traj = 1
     for key, h in block.items():
-        label = names.get(key) or key.replace("_", " ").replace(" m s", "").replace(" per rev",
-                                                                                      "/rev")
         k = 1e3 if abs(h["value"]) >= 1e4 and h["unit"] in ("N", "m/s^2") else 1.0
-        unit = ("k" if k > 1 else "") + h["unit"]
-        parts.append(f"{label} {h['value'] / k:.4g} ± {h['uncertainty'] / k:.2g} {unit}"
-                     + (" (spread)" if h["basis"] == "ensemble spread" else ""))
+        unit = ("k" if k > 1 else "") + (h["unit"] if h["unit"] != "1/rev" else "")
+        text = f"{_label(key)} {h['value'] / k:.4g}"
+        if h["uncertainty"] > 0.0:
+            text += f" ± {h['uncertainty'] / k:.2g}"
+        parts.append((text + (f" {unit}" if unit else "")
+                      + (" (spread)" if h["basis"] == "ensemble spread" else "")))
         n_traj = h["n_trajectories"]
     return (", ".join(parts) + f" (per-revolution means over {n_traj} trajector"
             f"{'ies' if n_traj > 1 else 'y'} x {n_revolutions} revs; ±: standard error, or the "

@@ -245,6 +245,9 @@ def run(params: dict, ctx) -> dict:
              "max_penetration_m": hist.peak("penetration",
                                             np.maximum(d["penetration"][sel], 0.0), cj.name, *tw),
              "contact_fraction": float(np.mean(d["penetration"][sel] > 0.0)),
+             # largest |e| / c in the window; with an oil film, the thinnest film c (1 - eps)
+             "eccentricity_ratio_max": float(np.max(np.hypot(d["ex"][sel], d["ey"][sel]))
+                                             / cj.clearance),
              "contact_duration_median_s": float(np.median(dur)) if dur.size else None}
         j.update(impact_statistics(hist.onsets[cj.name], v_min=cj.v_impact_min))
         if dur.size and np.median(dur) < 2.0 * dt:
@@ -259,6 +262,9 @@ def run(params: dict, ctx) -> dict:
         if ideal is not None:
             j["contact_loss"] = contact_loss_indicator(ideal.t[sel], ideal.joint_forces[cj.name][sel],
                                                        ideal.crank_angle[sel])
+        if getattr(cj, "viscosity", None):
+            j["min_film_thickness_m"] = max(cj.clearance * (1.0 - j["eccentricity_ratio_max"]),
+                                            0.0)
         joints[cj.name] = j
     res["clearance_joints"] = joints
     # per-revolution statistics: what converges (a single trajectory's peak does not)
@@ -352,10 +358,16 @@ def run(params: dict, ctx) -> dict:
         headline_text = f"main-bearing peak {res['main_bearing_force_peak_n']:.4g} N, {motion}"
     res["summary"] = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {t_end:g} s: {headline_text}, "
                       f"{n_imp} impacts, energy balance {res['energy_balance_error']:.1e}")
+    for name, j in joints.items():
+        if "min_film_thickness_m" in j:
+            res["summary"] += (f"; {name} oil film: thinnest {1e6 * j['min_film_thickness_m']:.3g}"
+                               f" um (eccentricity ratio {j['eccentricity_ratio_max']:.3g})")
     if "ensemble" in res:
+        from ..report.quantity import quantity_range  # 15.99–34.56 kN, not 1.599e+04-3.456e+04
+
         e = res["headline"]["main_bearing_per_rev_peak_n"]
-        res["summary"] += (f"; {p['ensemble']} trajectories started 1e-12 apart give "
-                           f"main-bearing per-rev peaks {e['min']:.4g}-{e['max']:.4g} N")
+        res["summary"] += (f"; the {p['ensemble']} trajectories (started 1e-12 apart) range "
+                           f"{quantity_range(e['min'], e['max'], 'N')} in that peak")
     if bodies is not None:
         names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in res["flexible"]["bodies"].items())
         res["summary"] += f"; flexible: {names}"
