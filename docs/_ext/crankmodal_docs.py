@@ -153,7 +153,19 @@ def scene_markdown() -> str:
         "A scene file holds `name = \"...\"` and one section per stage to run; a section may "
         "take `machine = \"NAME\"` to pull its defaults from `geometry/NAME.toml`.",
         "",
+        "## Top-level keys",
+        "",
+        "| key | type | default | meaning |",
+        "|---|---|---|---|",
     ]
+    from crankmodal.scene import TOP_LEVEL_KEYS
+    meaning = {"name": ("the file's stem", "the scene's name; the default output folder is "
+                        "`out/<name>/`"),
+               "description": ('`""`', "free text about the scene")}
+    for key in TOP_LEVEL_KEYS:
+        default, text = meaning.get(key, ("-", ""))
+        lines.append(f"| `{key}` | string | {default} | {text} |")
+    lines.append("")
     for table, what, schema in schema_tables():
         what = what.replace("[reports](../guide/reports.md)", _guide_link("reports.md", "reports"))
         title = f"`[{table}]`" if not table.startswith("[") else f"`[{table}]`"
