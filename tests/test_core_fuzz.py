@@ -451,3 +451,251 @@ def test_run_of_a_mesh_with_a_non_finite_point(suffix, value, fe, tmp_path):
     status, stderr = run_in_process("run", scene, "--out", out)
     problem = one_error_line_problem(status, stderr, "geometry") or output_folder_problem(out)
     assert problem is None, problem
+
+
+# --- issue 25 items 6-8: sizes the geometry kernel cannot take, damaged flexbody files and the
+# Python API's argument types. A part length of 1e15 m passed check and killed `run` (exit 139:
+# OpenCASCADE); a bit-flipped or NaN-holding flexbody gave tracebacks or ran; build_part("fuzz"),
+# load_flexbody(None) and bar(divisions=(1e6, ...)) raised raw TypeErrors and MemoryErrors.
+
+#: huge and subnormal values tried on every part length (all outside 1 um..100 m)
+HUGE_AND_SUBNORMAL = ("1e15", "1e30", "1e-310", "5e-324")
+
+
+def part_scenes():
+    """Ready scenes whose [geometry] builds a machine's part (with gmsh, at `run`)."""
+    out = []
+    for f in SCENE_FILES:
+        geo = load_scene(f).sections.get("geometry", {})
+        if isinstance(geo.get("machine"), str):
+            out.append(f)
+    return out
+
+
+def length_mutations(scene_file) -> list[tuple[str, str]]:
+    """``geometry.params.<length>`` x :data:`HUGE_AND_SUBNORMAL` of a part scene."""
+    from crankmodal.geometry.params import PART_TYPES, length_fields
+
+    geo = load_scene(scene_file).sections["geometry"]
+    part = geo.get("part", "crankshaft")
+    names = length_fields(PART_TYPES[part]())
+    return [(f"geometry.params.{n}", v) for n in names for v in HUGE_AND_SUBNORMAL]
+
+
+@pytest.mark.parametrize("scene_file", part_scenes(), ids=lambda p: p.stem)
+def test_check_refuses_every_part_length_the_kernel_cannot_take(scene_file):
+    """Every length of the part, huge or subnormal: exit 2 naming it (never 0: at `run`
+    OpenCASCADE would get it)."""
+    problems = []
+    for k, v in length_mutations(scene_file):
+        status, stderr = run_in_process("check", scene_file, "--set", f"{k}={v}")
+        p = error_problem(status, stderr, k, v, allowed=(2,))
+        if p is not None:
+            problems.append(f"--set {k}={v}: {p}")
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize("value", HUGE_AND_SUBNORMAL)
+def test_run_of_a_part_length_the_kernel_cannot_take_ends_cleanly(cli, value, tmp_path):
+    """Through `run` in a subprocess (before the fix: a segmentation fault, exit 139), one
+    length per value from a fixed-seed sample of the part scenes."""
+    scene_file = sample(part_scenes(), 1, value)[0]
+    key, _ = sample([m for m in length_mutations(scene_file) if m[1] == value], 1, scene_file.stem)[0]
+    out = tmp_path / "out"
+    proc = cli("run", scene_file, "--set", f"{key}={value}", "--out", out, "--no-figures")
+    problem = error_problem(proc.returncode, proc.stderr, key, value, allowed=(2,))
+    assert problem is None and not (out / "results.json").exists(), problem
+
+
+#: mutations of one member of a flexbody file: name -> new value from the old one (None: drop it)
+def _first(a, value):
+    a = np.array(a, dtype=float) if np.asarray(a).dtype.kind in "biuf" else np.zeros(1)
+    if a.ndim == 0:
+        return np.array(value)
+    a.flat[0] = value
+    return a
+
+
+MEMBER_MUTATIONS = {
+    "nan": lambda a: _first(a, np.nan), "inf": lambda a: _first(a, np.inf),
+    "-1": lambda a: _first(a, -1.0), "1e12": lambda a: _first(a, 1e12),
+    "text": lambda a: np.array("fuzz"), "pickled": lambda a: np.array([None, 1], dtype=object),
+    "dropped": lambda a: None, "empty": lambda a: np.zeros((0,)),
+    "reshaped": lambda a: a.reshape(-1)[:-1] if np.asarray(a).size > 1 else np.zeros((2, 2)),
+}
+N_FILE = 40     # sampled flexbody mutations through check and the API (default run)
+N_FILE_RUN = 3  # of them through run (default run)
+
+
+@pytest.fixture(scope="module")
+def flexbody_file(tmp_path_factory):
+    """A sound flexbody of the loom's coupler (a coarse P1 bar reduced here, ~1 s)."""
+    import shutil
+
+    folder = tmp_path_factory.mktemp("flexbody")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("CRANKMODAL_CACHE", str(folder / "cache"))
+        from crankmodal.dynamics.flexbuild import reduced_bar
+
+        path = reduced_bar(0.075, (0.05, 0.077), {"mesh_size": 0.025, "element_order": 1,
+                                                  "material": "steel", "fixed_interface_modes": 4},
+                           "dynamics.flexible.coupler")
+    return shutil.copy(path, folder / "good.npz")
+
+
+def file_mutations(good) -> list[tuple[str, str]]:
+    with np.load(good) as z:
+        return [(m, k) for m in z.files for k in MEMBER_MUTATIONS]
+
+
+def mutated_flexbody(good, member, kind, folder):
+    """The scene (the loom four-bar, its coupler from the file) and the mutated file."""
+    with np.load(good) as z:
+        data = {k: z[k] for k in z.files}
+    new = MEMBER_MUTATIONS[kind](data[member])
+    if new is None:
+        del data[member]
+    else:
+        data[member] = new
+    npz = folder / "coupler.npz"
+    with open(npz, "wb") as fh:
+        np.savez(fh, **data)
+    scene = folder / "coupler.toml"
+    scene.write_text('[dynamics]\nmachine = "loom_four_bar"\nend_time = 0.01\n'
+                     '[dynamics.solver]\nmethod = "Radau"\n'
+                     '[dynamics.flexible]\ncoupler = { file = "coupler.npz" }\n')
+    return scene, npz
+
+
+def file_problem(good, member, kind, folder, command="check"):
+    """What is wrong with crankmodal's answer to a flexbody with one member mutated: through
+    the API (load_flexbody returns, or raises FlexbodyFileError naming a member) and the CLI
+    (exit 0, or 2 with one line naming the scene key and the file)."""
+    from crankmodal.reduction.io import FlexbodyFileError, load_flexbody
+
+    folder.mkdir(parents=True, exist_ok=True)
+    scene, npz = mutated_flexbody(good, member, kind, folder)
+    try:
+        load_flexbody(npz)
+    except FlexbodyFileError as exc:
+        if str(npz) not in str(exc):
+            return f"API error does not name the file: {exc}"
+    except Exception as exc:  # noqa: BLE001 - any other exception is the defect reported
+        return f"API: {type(exc).__name__}: {exc}"
+    out = folder / "out"
+    extra = ("--out", out, "--no-figures") if command == "run" else ()
+    try:
+        status, stderr = run_in_process(command, scene, *extra)
+    except Exception as exc:  # noqa: BLE001
+        return f"{type(exc).__name__} escaped: {exc}"
+    problem = error_problem(status, stderr, "dynamics.flexible.coupler.file", kind,
+                            allowed=(0, 2, 3) if command == "run" else (0, 2))
+    if problem is None and status == 2 and str(npz) not in stderr:
+        problem = f"error does not name the file: {stderr.strip()}"
+    if problem is None and command == "run":
+        if status == 0:
+            try:
+                strict_json(out / "results.json")
+            except (OSError, ValueError) as exc:
+                problem = f"exit 0 but results.json bad: {exc}"
+        elif (out / "results.json").exists():
+            problem = f"exit {status} but results.json written"
+    return problem
+
+
+def _files_all(good, items, tmp_path, command):
+    problems = [f"{m} {k}: {p}" for i, (m, k) in enumerate(items)
+                if (p := file_problem(good, m, k, tmp_path / str(i), command)) is not None]
+    assert not problems, "\n".join(problems)
+
+
+def test_check_of_flexbody_files_with_a_damaged_member(flexbody_file, tmp_path):
+    _files_all(flexbody_file, sample(file_mutations(flexbody_file), N_FILE, "file"), tmp_path,
+               "check")
+
+
+def test_run_of_flexbody_files_with_a_damaged_member(flexbody_file, tmp_path):
+    _files_all(flexbody_file, sample(file_mutations(flexbody_file), N_FILE_RUN, "file run"),
+               tmp_path, "run")
+
+
+@pytest.mark.slow
+def test_check_of_flexbody_files_every_damaged_member(flexbody_file, tmp_path):
+    _files_all(flexbody_file, file_mutations(flexbody_file), tmp_path, "check")
+
+
+#: wrong values of every type tried on the Python API's arguments
+BAD_ARGUMENTS = ["fuzz", None, [1.0], {"a": 1}, math.nan, math.inf, -1, 0, 1e30, 5e-324, True]
+
+
+def api_calls():
+    """name -> (function, keyword arguments that work); each argument is mutated alone."""
+    from crankmodal.dynamics.flexbuild import reduced_bar
+    from crankmodal.fem.testparts import bar, check_bar_size
+    from crankmodal.geometry import ConrodParams, MeshSettings, build_part
+    from crankmodal.geometry.importers import import_mesh
+    from crankmodal.geometry.mesh import check_size_floor
+    from crankmodal.reduction.io import load_flexbody
+
+    def mesh_settings(size=0.01, order=1, refine=0.4):
+        return build_part(ConrodParams(), "full", MeshSettings(size, order=order, refine=refine))
+
+    spec = {"mesh_size": 0.025, "element_order": 1, "material": "steel", "fixed_interface_modes": 4}
+    return {
+        "load_flexbody": (load_flexbody, {"path": "good.npz"}),
+        "import_mesh": (import_mesh, {"path": "part.vtu"}),
+        "build_part": (build_part, {"params": ConrodParams(), "fidelity": "full",
+                                    "settings": MeshSettings(0.01, order=1)}),
+        "MeshSettings": (mesh_settings, {"size": 0.01, "order": 1, "refine": 0.4}),
+        "check_size_floor": (check_size_floor, {"params": ConrodParams(),
+                                                "settings": MeshSettings(0.01)}),
+        "bar": (bar, {"length": 0.075, "width": 0.05, "height": 0.077, "divisions": (3, 2, 4),
+                      "order": 1}),
+        "check_bar_size": (check_bar_size, {"dims": (0.075, 0.05, 0.077), "size": 0.025,
+                                            "max_elements": 5e6, "reason": "test"}),
+        "reduced_bar": (reduced_bar, {"length": 0.075, "section": (0.05, 0.077), "spec": spec,
+                                      "key": "coupler"}),
+        **{f"reduced_bar spec.{k}": ((lambda k: lambda **kw: reduced_bar(
+            0.075, (0.05, 0.077), {**spec, k: kw[k]}, "coupler"))(k), {k: v})
+           for k, v in spec.items()},
+    }
+
+
+def test_api_arguments_of_every_type_raise_one_clear_error(flexbody_file, tmp_path, monkeypatch):
+    """Each argument of the API functions behind items 6-8 replaced by a wrong value of every
+    type: the call returns, or raises a CrankmodalError (a ParameterError naming the argument
+    for a wrong type); never a TypeError, AttributeError or MemoryError, and never OpenCASCADE
+    (replaced by a failure here: the kernel would run, or crash, on what passed)."""
+    import shutil
+
+    import meshio
+
+    from crankmodal.errors import CrankmodalError, ParameterError
+
+    def kernel(*a, **k):
+        raise AssertionError("OpenCASCADE reached")
+
+    monkeypatch.setattr("crankmodal.geometry.build.gmsh_session", kernel)
+    monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path / "cache"))
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(flexbody_file, tmp_path / "good.npz")
+    meshio.write(tmp_path / "part.vtu", meshio.Mesh(
+        0.01 * np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]),
+        [("tetra", np.array([[0, 1, 2, 3]]))]))
+    problems = []
+    for name, (fn, kwargs) in api_calls().items():
+        for arg in kwargs:
+            if arg in ("key", "reason"):
+                continue  # texts for messages only
+            for bad in BAD_ARGUMENTS:
+                try:
+                    fn(**{**kwargs, arg: bad})
+                except ParameterError:
+                    pass
+                except CrankmodalError as exc:
+                    if type(bad) is not type(kwargs[arg]) and arg != "path":
+                        problems.append(f"{name}({arg}={bad!r}): {type(exc).__name__} for a "
+                                        f"wrong type, not a ParameterError: {exc}")
+                except Exception as exc:  # noqa: BLE001 - the defect reported
+                    problems.append(f"{name}({arg}={bad!r}): {type(exc).__name__}: {exc}")
+    assert not problems, "\n".join(problems)

@@ -370,18 +370,20 @@ def test_run_refuses_a_bar_too_fine_or_too_small(assignment, tmp_path):
 
 
 def test_subnormal_mesh_size_is_a_refusal_not_a_division_by_zero():
-    from crankmodal.geometry.mesh import MeshSettings, MeshSizeError, check_size, check_size_floor
+    from crankmodal.geometry.mesh import MeshSettings, check_size, check_size_floor, estimate_elements
     from crankmodal.geometry.params import ConrodParams
 
-    for size in (1e-300, 5e-324):
-        with pytest.raises(MeshSizeError, match="more than 1e308 tetrahedra"):
-            check_size_floor(ConrodParams(), MeshSettings(size))
-        with pytest.raises(MeshSizeError):
-            check_size(1e-3, 1e-2, MeshSettings(size))
-    assert check_size(1e-3, 1e-2, MeshSettings(1e200)) == 0.0  # was an OverflowError
+    for size in (1e-300, 5e-324, 1e30):
+        for call in (lambda s: check_size_floor(ConrodParams(), s), lambda s: check_size(1e-3, 1e-2, s)):
+            with pytest.raises(ParameterError, match=r"size: must be in \[1e-06, 100\] m"):
+                call(MeshSettings(size))
+    # 8.5 V / h^3 + 17.5 A / h^2, overflowing to inf and underflowing to 0 without an exception
+    assert estimate_elements(1e-3, 1e-2, 1e-300) == np.inf  # was a ZeroDivisionError
+    assert estimate_elements(1e-3, 1e-2, 1e200) == 0.0  # was an OverflowError
+    assert estimate_elements(1e-3, 1e-2, 0.01) == pytest.approx(8.5e3 + 17.5e2, rel=1e-12)
     status, stderr = run_in_process("check", SCENES / "seed000_rod_static.toml", "--set",
                                     "geometry.mesh_size=1e-300")
-    one_error_line(status, stderr, "geometry.mesh_size = 1e-300 m")
+    one_error_line(status, stderr, "geometry.mesh_size: must be in [1e-06, 100] m")
 
 
 @pytest.mark.parametrize("scale, fragment", [(1e200, "spans 1e+198 m"), (1e-200, "spans 1e-202 m"),

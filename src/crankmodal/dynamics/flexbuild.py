@@ -334,6 +334,29 @@ def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
     return body
 
 
+def _bar_arguments(length, section, spec) -> None:
+    """The Python API's arguments of :func:`reduced_bar` (a scene's are validated already):
+    a ParameterError naming ``length``, ``section`` or ``spec.<key>``."""
+    from ..geometry.mesh import is_length
+
+    if not is_length(length):
+        raise ParameterError("length", f"must be a number > 0 m, got {length!r}")
+    if (not isinstance(section, (tuple, list)) or len(section) != 2
+            or not all(is_length(v) for v in section)):
+        raise ParameterError("section", f"must be [width, thickness], two numbers > 0 m, got "
+                             f"{section!r}")
+    if not isinstance(spec, dict):
+        raise ParameterError("spec", f"must be a dict, got {type(spec).__name__}")
+    checks = {"mesh_size": (is_length, "a number > 0 m"),
+              "element_order": (lambda v: v in (1, 2) and not isinstance(v, bool), "1 or 2"),
+              "material": (lambda v: isinstance(v, str), "a material name"),
+              "fixed_interface_modes": (lambda v: isinstance(v, int) and not isinstance(v, bool)
+                                        and 0 <= v <= 400, "an integer in [0, 400]")}
+    for k, (ok, rule) in checks.items():
+        if k not in spec or not ok(spec[k]):
+            raise ParameterError(f"spec.{k}", f"must be {rule}, got {spec.get(k, 'nothing')!r}")
+
+
 def check_bar(length: float, section, spec: dict, key: str) -> tuple:
     """Refuse the bar of :func:`reduced_bar` before anything is built; return its divisions.
 
@@ -356,6 +379,7 @@ def check_bar(length: float, section, spec: dict, key: str) -> tuple:
     from ..geometry.checks import MAX_LENGTH, MIN_LENGTH
     from ..geometry.mesh import MAX_ELEMENTS, MeshSizeError, fe_element_limit
 
+    _bar_arguments(length, section, spec)
     sizes = f"the sizes crankmodal builds, [{MIN_LENGTH:g}, {MAX_LENGTH:g}] m"
     if not MIN_LENGTH <= length <= MAX_LENGTH:
         raise SceneError(f"dynamics.four_bar.lengths: the {key.rsplit('.', 1)[-1]} bar reduced "

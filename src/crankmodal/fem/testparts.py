@@ -49,6 +49,18 @@ def _grid(n):
 TETS_PER_CELL = 6
 
 
+def _check_dims(dims, names=("length", "width", "height")) -> None:
+    """Refuse box sides that are not finite numbers > 0 m (a ParameterError naming the side)."""
+    from ..errors import ParameterError
+    from ..geometry.mesh import is_length
+
+    if not isinstance(dims, (tuple, list)) or len(dims) != 3:
+        raise ParameterError("dims", f"must be three lengths (m), got {dims!r}")
+    for name, d in zip(names, dims):
+        if not is_length(d):
+            raise ParameterError(name, f"must be a number > 0 m, got {d!r}")
+
+
 def bar_divisions(dims, size: float) -> tuple:
     """Cells along each side of a box ``dims`` (m) at about ``size`` (m) per edge:
     ``max(1, ceil(d / size))`` each, as floats (``inf`` for a subnormal size, so that
@@ -75,8 +87,14 @@ def check_bar_size(dims, size: float, max_elements: float, reason: str) -> tuple
         Naming ``size``, the count, the limit (``reason`` says why it is what it is) and the
         smallest size it allows.
     """
-    from ..geometry.mesh import MeshSizeError
+    from ..errors import ParameterError
+    from ..geometry.mesh import MeshSizeError, is_length
 
+    if not is_length(size):
+        raise ParameterError("size", f"must be a number > 0 m, got {size!r}")
+    if not is_length(max_elements):
+        raise ParameterError("max_elements", f"must be a number > 0, got {max_elements!r}")
+    _check_dims(dims)
     div = bar_divisions(dims, size)
     n = bar_elements(div)
     if n > max_elements:
@@ -106,6 +124,13 @@ def bar(length=1.0, width=0.05, height=0.05, divisions=(20, 2, 2), order=2) -> P
     from ..errors import ParameterError
     from ..geometry.mesh import MAX_ELEMENTS
 
+    _check_dims((length, width, height), ("length", "width", "height"))
+    if (not isinstance(divisions, (tuple, list)) or len(divisions) != 3
+            or not all(isinstance(d, (int, np.integer)) and not isinstance(d, bool) and d >= 1
+                       for d in divisions)):
+        raise ParameterError("divisions", f"must be three integers >= 1, got {divisions!r}")
+    if isinstance(order, bool) or order not in (1, 2):
+        raise ParameterError("order", f"must be 1 or 2, got {order!r}")
     if bar_elements(divisions) > MAX_ELEMENTS:
         raise ParameterError("divisions", f"{tuple(divisions)} makes {bar_elements(divisions):.3g} "
                              f"tetrahedra, over crankmodal's limit of {MAX_ELEMENTS:.3g}")

@@ -14,14 +14,9 @@ from .session import gmsh_session, quiet_stdout
 def _check_settings(settings: MeshSettings) -> None:
     """Refuse MeshSettings out of range with a ParameterError naming the field (``size``,
     ``order``, ``refine``)."""
-    from ..errors import ParameterError
+    from .mesh import check_settings
 
-    if not settings.size > 0:
-        raise ParameterError("size", f"must be > 0 m, got {settings.size!r}")
-    if settings.order not in (1, 2):
-        raise ParameterError("order", f"must be 1 or 2, got {settings.order!r}")
-    if not 0 < settings.refine <= 1:
-        raise ParameterError("refine", f"must be in (0, 1], got {settings.refine!r}")
+    check_settings(settings)  # also refuses a settings that is no MeshSettings, or a text size
 
 
 def mesh_tagged(gmsh, volumes: list, specs: list, settings: MeshSettings, refined=()):

@@ -78,6 +78,12 @@ def check_lengths(part: str, p) -> None:
                               f"resolves), got {lengths[small]!r}")
 
 
+def _of_type(p, cls) -> None:
+    if not isinstance(p, cls):  # build_part sends whatever is not a CrankshaftParams here
+        raise ParameterError("params", f"must be a CrankshaftParams or ConrodParams, got "
+                             f"{type(p).__name__} {p!r}"[:200])
+
+
 def _refuse(part: str, name: str, rule: str, value) -> GeometryError:
     return GeometryError(f"{part}.{name}: must be {rule}, got {value!r}")
 
@@ -125,6 +131,7 @@ def check_crankshaft(p: CrankshaftParams) -> CrankshaftParams:
         Naming the first offending parameter and its admissible range.
     """
     c = "crankshaft"
+    _of_type(p, CrankshaftParams)
     if not p.phases_deg or not all(isinstance(a, (int, float)) and math.isfinite(a) for a in p.phases_deg):
         raise _refuse(c, "phases_deg", "a non-empty list of finite angles in degrees", p.phases_deg)
     _positive(c, p, ("throw_radius", "journal_diameter", "journal_length", "pin_diameter",
@@ -215,6 +222,7 @@ def check_crankshaft(p: CrankshaftParams) -> CrankshaftParams:
 def check_conrod(p: ConrodParams) -> ConrodParams:
     """Refuse an impossible connecting rod; return ``p`` unchanged when admissible."""
     c = "rod"
+    _of_type(p, ConrodParams)
     _positive(c, p, ("length", "big_end_bore", "big_end_outer_diameter", "big_end_width",
                      "small_end_bore", "small_end_outer_diameter", "small_end_width",
                      "shank_depth", "shank_width", "shank_web_thickness", "shank_flange_thickness",

@@ -56,7 +56,9 @@ def import_cad(path, specs: list, settings: MeshSettings) -> Part:
     from .massprops import cad_mass_properties, compare, mesh_mass_properties
     from .session import gmsh_session, quiet_stdout
 
-    path = Path(path)
+    from ..reduction.io import file_argument
+
+    path = file_argument(path)
     if not path.is_file():
         raise InputFileError(f"geometry.file: file not found: {path}")
     with gmsh_session(f"import {path.name}", {"file": str(path)}) as gmsh:
@@ -173,7 +175,9 @@ def import_mesh(path, specs: list = ()) -> Part:
     """
     import meshio
 
-    path = Path(path)
+    from ..reduction.io import file_argument
+
+    path = file_argument(path)
     if not path.is_file():
         raise InputFileError(f"geometry.file: file not found: {path}")
     try:

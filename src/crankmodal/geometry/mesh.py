@@ -56,6 +56,38 @@ class MeshSettings:
         return {"size": self.size, "order": self.order, "refine": self.refine, "optimize": self.optimize}
 
 
+def is_length(value) -> bool:
+    """Whether ``value`` is a real number (not a bool), finite and > 0."""
+    import math
+
+    return (isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+            and math.isfinite(value) and value > 0)
+
+
+def check_settings(settings) -> MeshSettings:
+    """Return ``settings`` if it is a :class:`MeshSettings` in range; else a ParameterError
+    naming ``settings`` (not one) or its field ``size``, ``order`` or ``refine``."""
+    if not isinstance(settings, MeshSettings):
+        raise ParameterError("settings", f"must be a MeshSettings, got {type(settings).__name__} "
+                             f"{settings!r}")
+    from .checks import MAX_LENGTH, MIN_LENGTH
+
+    if not is_length(settings.size):
+        raise ParameterError("size", f"must be > 0 m{' and finite' if settings.size == float('inf') else ''}, "
+                             f"got {settings.size!r}")
+    if not MIN_LENGTH <= settings.size <= MAX_LENGTH:  # gmsh would get a size it cannot mesh at
+        raise ParameterError("size", f"must be in [{MIN_LENGTH:g}, {MAX_LENGTH:g}] m, the sizes "
+                             f"crankmodal builds, got {settings.size!r}")
+    if isinstance(settings.order, bool) or settings.order not in (1, 2):
+        raise ParameterError("order", f"must be 1 or 2, got {settings.order!r}")
+    if not (is_length(settings.refine) and settings.refine <= 1):
+        raise ParameterError("refine", f"must be in (0, 1], got {settings.refine!r}")
+    if settings.refine * settings.size < MIN_LENGTH:  # the size at fillets and holes
+        raise ParameterError("refine", f"must be >= {MIN_LENGTH / settings.size:.3g} (refine x size "
+                             f">= {MIN_LENGTH:g} m at the details), got {settings.refine!r}")
+    return settings
+
+
 #: Largest number of tetrahedra meshed: gmsh's own memory and time grow past several GB and
 #: minutes above it, and the FE stages could not solve it on a workstation anyway.
 MAX_ELEMENTS = 5e6
@@ -172,6 +204,7 @@ def check_size(volume: float, area: float, settings: MeshSettings) -> float:
         Naming ``size``, the estimate, the limit and the smallest size it allows (a
         ParameterError and a ResourceError).
     """
+    check_settings(settings)
     n = estimate_elements(volume, area, settings.size)
     if n > settings.max_elements:
         raise MeshSizeError(settings.size, "about", n,
@@ -196,7 +229,12 @@ def volume_floor_terms(params) -> list[tuple[str, float, dict]]:
     """
     from math import hypot, pi
 
+    from .params import PART_TYPES
+
     p = params
+    if not isinstance(p, tuple(PART_TYPES.values())):
+        raise ParameterError("params", f"must be a CrankshaftParams or ConrodParams, got "
+                             f"{type(p).__name__}")
     if hasattr(p, "phases_deg"):  # CrankshaftParams
         n = len(p.phases_deg)
         lj = max(p.journal_length - 2.0 * p.journal_chamfer, 0.0)
@@ -237,6 +275,7 @@ def check_size_floor(params, settings: MeshSettings) -> float:
         huge part is as likely the cause as a tiny size), the limit and the smallest size it
         allows.
     """
+    check_settings(settings)
     terms = volume_floor_terms(params)
     v = sum(t[1] for t in terms)
     h = settings.size

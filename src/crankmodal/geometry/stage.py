@@ -106,10 +106,12 @@ def validate(raw: dict, scene) -> dict:
     p["part_params"] = params
     from .mesh import MeshSizeError, check_size_floor
 
-    try:  # run estimates again, closer, on the CAD solid
-        check_size_floor(params, mesh_settings(p))
-    except MeshSizeError as exc:
-        raise SceneError(exc.worded("geometry.mesh_size", "geometry.params.")) from None
+    # run estimates again, closer, on the CAD solid; a size or refine out of range is named
+    with scene_keys(SECTION, {"size": "mesh_size", "order": "element_order"}):
+        try:
+            check_size_floor(params, mesh_settings(p))
+        except MeshSizeError as exc:
+            raise SceneError(exc.worded("geometry.mesh_size", "geometry.params.")) from None
     return p
 
 

@@ -211,6 +211,18 @@ class _Members:
         return a
 
 
+def file_argument(path, name: str = "path") -> Path:
+    """``path`` as a Path, or a ParameterError naming ``name`` when it is no file name."""
+    import os
+
+    if not isinstance(path, (str, os.PathLike)) or not str(path):
+        from ..errors import ParameterError
+
+        raise ParameterError(name, f"must be a file name (str or path), got "
+                             f"{type(path).__name__} {path!r}"[:200])
+    return Path(path)
+
+
 def _kind(a: np.ndarray) -> str:
     return f"{a.dtype} of shape {a.shape}"
 
@@ -254,6 +266,8 @@ def load_flexbody(path) -> FlexibleBody:
 
     Raises
     ------
+    ParameterError
+        ``path`` is no file name.
     InputFileError
         Missing file.
     FlexbodyFileError
@@ -261,7 +275,7 @@ def load_flexbody(path) -> FlexibleBody:
         ``crankmodal-flexbody`` file of a known version, or a member that is missing, of the
         wrong kind or shape, non-finite, or out of its physical range.
     """
-    path = Path(path)
+    path = file_argument(path)
     z = _open(path)
     with z:
         r = _Members(path, z)
@@ -284,7 +298,10 @@ def _members(r: _Members) -> dict:
     if rigid.dtype != bool or rigid.shape != (n,):
         raise r.fail("rigid", f"must be {n} booleans (one per mode), got {_kind(rigid)}")
     ne = int((~rigid).sum())
-    names = r.texts("interface_names", len(r.raw("interface_names")))
+    raw_names = r.raw("interface_names")
+    if raw_names.ndim != 1:
+        raise r.fail("interface_names", f"must be a list of texts, got {_kind(raw_names)}")
+    names = r.texts("interface_names", len(raw_names))
     m = len(names)
     if len(set(names)) != m:
         raise r.fail("interface_names", f"names an interface twice: {names}")
