@@ -225,3 +225,19 @@ def test_piston_plot_draws_the_ideal_run_dashed_on_top_and_the_last_revolutions(
         assert ideal_line[0].get_zorder() > max(ln.get_zorder() for ln in other)
     last = axes[1].get_lines()[0].get_xdata()
     assert len(last) == 1001 and min(last) == pytest.approx(0.0) and max(last) == pytest.approx(720)
+
+
+def test_the_drive_torques_sign_is_stated_and_holds_in_the_run(scene_report):
+    """Issue 25 #15: the four-star crank turns from +y towards +x, i.e. about -z, so the
+    torque that drives it is negative about +z while the power it delivers (a compressor takes
+    power) is positive; the report says so under the dynamics table."""
+    out, _ = scene_report
+    d = np.load(out / "dynamics.npz")
+    late = d["t"] > 0.03  # after the 0.02 s ramp
+    assert np.all(d["crank_speed"][late] < 0)
+    assert np.mean(d["drive_torque"][late]) < 0 < np.mean(d["drive_power"][late])
+    sec = next(b for t, b in _sections((out / "report.html").read_text()).items()
+               if t.endswith("[dynamics]"))
+    text = htmlmod.unescape(sec)
+    assert "the drive torque is the torque the drive applies to the crank about +z" in text
+    assert "its driving torque is negative while the power is positive" in text

@@ -185,8 +185,9 @@ def plot_drive(hist, ideal, path: Path, window=None) -> Path:
     ax[1].plot(hist.t, hist.drive_power, lw=0.7)
     for k, a in enumerate(ax):
         mark_window(a, window, label=k == 0)
-    ax[0].set(ylabel="drive torque [N m]")
-    ax[1].set(xlabel="t [s]", ylabel="drive power [W]")
+    # the sign (issue 25 #15): about +z, while a crank turning from +y towards +x turns about -z
+    ax[0].set(ylabel="drive torque on the crank\nabout +z [N m]")
+    ax[1].set(xlabel="t [s]", ylabel="drive power = torque x crank\nspeed about +z [W] (> 0: delivered)")
     ax[0].legend()
     return _save(plt, fig, path)
 

@@ -308,6 +308,15 @@ def reduction_blocks(report: Report, res: dict) -> None:
                       for k, f in enumerate(fr[:12])])
 
 
+#: the drive's sign in [dynamics] (its torque is about +z; the crank's sense of rotation may
+#: be -z, as for the crank trains, whose angle runs from +y towards +x)
+DRIVE_CONVENTION = ("Sign convention: the drive torque is the torque the drive applies to the "
+                    "crank about +z; the drive power is that torque times the crank's angular "
+                    "speed about +z, positive when the drive delivers power. A crank turning "
+                    "from +y towards +x (the crank trains) turns about −z, so its driving torque "
+                    "is negative while the power is positive.")
+
+
 def dynamics_blocks(report: Report, res: dict) -> None:
     """Key numbers against the ideal-joint run, the clearance joints, per-revolution
     statistics."""
@@ -317,7 +326,7 @@ def dynamics_blocks(report: Report, res: dict) -> None:
             ["main-bearing moment peak", fmt(res.get("main_bearing_moment_peak_nm"), "N m"), None],
             ["piston acceleration peak", fmt(res.get("piston_acceleration_peak"), "m/s²"),
              fmt(ideal.get("piston_acceleration_peak"), "m/s²")],
-            ["drive torque peak", fmt(res.get("drive_torque_peak_nm"), "N m"), None],
+            ["drive torque peak, |T|", fmt(res.get("drive_torque_peak_nm"), "N m"), None],
             ["drive power mean", fmt(res.get("drive_power_mean_w"), "W"),
              fmt(ideal.get("drive_power_mean_w"), "W")],
             ["energy balance error", fmt(res.get("energy_balance_error"), digits=2), None],
@@ -331,6 +340,8 @@ def dynamics_blocks(report: Report, res: dict) -> None:
         report.table(["quantity", "this run", "ideal joints"], rows)
     else:
         report.table(["quantity", "value"], [r[:2] for r in rows])
+    if res.get("drive_power_mean_w") is not None:
+        report.paragraph(DRIVE_CONVENTION)
     joints = res.get("clearance_joints") or {}
     if joints:
         report.heading("Clearance joints", level=3)
