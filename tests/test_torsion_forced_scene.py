@@ -139,3 +139,35 @@ def test_bad_forced_input_exits_2_with_one_line_naming_the_key(tmp_path, overrid
     assert len(lines) == 1 and key in lines[0], p.stderr
     assert "Traceback" not in p.stderr
     assert not (tmp_path / "results.json").exists()
+
+
+def test_fe_beside_train_solid_chain_of_one_throw_is_the_two_rotor_closed_form():
+    import tomllib
+
+    from crankmodal.torsion.crank_model import crank_model
+    from crankmodal.torsion.fe_beside import fe_beside_train
+
+    t = tomllib.loads((SCENES.parent / "geometry" / "multi_bearing_compressor.toml").read_text())["torsion"]
+    m = crank_model(t["throw"], t["flywheel"], t["G"], t["density"], 1)
+    out = fe_beside_train([205.0], [300.0, 500.0, 900.0], ["bending about x", "torsion about z", "torsion about z"], m)
+    j1 = m.throw_parts["crankpin"] + m.throw_parts["webs"]
+    closed = math.sqrt(m.stiffness * (1 / j1 + 1 / m.flywheel_inertia)) / (2 * math.pi)
+    first = out["rows"][0]
+    assert first["fe_mode"] == 2 and first["fe_hz"] == 500.0 and first["chain_hz"] == 205.0
+    assert first["solid_chain_hz"] == pytest.approx(closed, rel=1e-12)
+    assert first["solid_chain_vs_fe"] == pytest.approx(closed / 500.0 - 1, rel=1e-12)
+    assert "chain_hz" not in out["rows"][1]
+
+
+@pytest.mark.slow
+def test_fe_crank_torsion_modes_beside_the_forced_chain(tmp_path):
+    scene = load_scene(SCENES / "torsion_seed004_crank_fe.toml",
+                       ["geometry.mesh_size=0.03", "geometry.fidelity='dechamfered'", "modal.n_modes=8"])
+    from crankmodal.runner import run
+
+    res = run(scene, tmp_path, figures=False)
+    fe = res["torsion"]["forced"]["fe_comparison"]
+    classes = res["modal"]["classes"]
+    assert fe["rows"] and all(classes[r["fe_mode"] - 1].startswith("torsion") for r in fe["rows"])
+    # the solid-only chain is stiffer-per-inertia than the running one (no reciprocating inertia)
+    assert fe["rows"][0]["solid_chain_hz"] > fe["rows"][0]["chain_hz"]

@@ -244,7 +244,7 @@ def validate(tp: dict, scene, chain, model) -> dict:
         raise SceneError(f"{KEY}.drive_section: must be 1..{len(chain.stiffnesses)}, got {drive}")
     f.update(speeds=speeds, excitation=excitation, train=train, machine=machine, arrangement=arrangement,
              efforts=efforts, section_objects=sections, section_names=names, allowable=allowable,
-             operating=list(ops), drive=drive - 1, cycle_revolutions=cr)
+             operating=list(ops), drive=drive - 1, cycle_revolutions=cr, crank_model=model)
     return f
 
 
@@ -320,6 +320,12 @@ def run(f: dict, ctx, chain) -> dict:
         "files": files,
         "summary": summary,
     }
+    modal = ctx.results.get("modal")
+    if modal and modal.get("classes"):  # the FE crank of the same scene, mode by mode
+        from .fe_beside import fe_beside_train
+
+        result["fe_comparison"] = fe_beside_train(natural_hz, modal["frequencies_hz"], modal["classes"],
+                                                  f["crank_model"])
     if f["arrangement"] is not None:
         result["arrangement"] = f["arrangement"].to_dict()
         eff = f["efforts"]
