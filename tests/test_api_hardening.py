@@ -25,16 +25,13 @@ R = 0.05  # crank radius of the test machines, m
 
 
 def cyl(**kw):
-    d = dict(axis_angle=np.pi / 2, rod_length=0.2, rod_mass=1.0, rod_inertia=0.004, rod_com=0.06,
-             piston_mass=0.8)
-    d.update(kw)
-    return cm.Cylinder(**d)
+    d = {"axis_angle": np.pi / 2, "rod_length": 0.2, "rod_mass": 1.0, "rod_inertia": 0.004,
+         "rod_com": 0.06, "piston_mass": 0.8}
+    return cm.Cylinder(**{**d, **kw})
 
 
 def mech(**kw):
-    d = dict(crank_radius=R, cylinders=[cyl()], speed_rpm=1500.0)
-    d.update(kw)
-    return cm.crank_train(**d)
+    return cm.crank_train(**{"crank_radius": R, "cylinders": [cyl()], "speed_rpm": 1500.0, **kw})
 
 
 @pytest.fixture(scope="module")
@@ -59,9 +56,9 @@ def bar_crank():
     return reduced
 
 
-FOUR_BAR = dict(crank_length=0.035, coupler_length=0.075, rocker_length=0.145,
-                rocker_pivot=(-0.008, 0.1598), masses=(35.8, 2.27, 10.42),
-                inertias=(0.0155, 0.00114, 0.0528), speed_rpm=200.0)
+FOUR_BAR = {"crank_length": 0.035, "coupler_length": 0.075, "rocker_length": 0.145,
+            "rocker_pivot": (-0.008, 0.1598), "masses": (35.8, 2.27, 10.42),
+            "inertias": (0.0155, 0.00114, 0.0528), "speed_rpm": 200.0}
 
 
 def four_bar(**kw):
@@ -175,6 +172,29 @@ PROBES = [
      "max_order"),
     ("critical-speeds-range-inf",
      lambda m, b: cm.critical_speeds([100.0], speed_range_rpm=(0.0, INF)), "speed_range_rpm[1]"),
+    ("two-rotor-inertia-nan", lambda m, b: cm.two_rotor(NAN, 1.0, 1e5), "inertia_flywheel"),
+    ("two-rotor-stiffness-zero", lambda m, b: cm.two_rotor(1.0, 1.0, 0.0), "stiffness"),
+    ("holzer-points-1e12",
+     lambda m, b: cm.holzer(cm.TorsionalChain([1.0, 2.0], [1e5]), points_per_rotor=10**12),
+     "points_per_rotor"),
+    ("holzer-chain-str", lambda m, b: cm.holzer("chain"), "chain"),
+    ("exact-modes-chain-list", lambda m, b: cm.exact_modes([1.0, 2.0]), "chain"),
+    # bodies, laws, the integrator
+    ("rigid-body-mass-negative", lambda m, b: cm.RigidBody("b", -1.0, 1.0, {"a": (0.0, 0.0)}),
+     "mass"),
+    ("rigid-body-inertia-nan", lambda m, b: cm.RigidBody("b", 1.0, NAN, {"a": (0.0, 0.0)}),
+     "inertia"),
+    ("rigid-body-frame-one-number", lambda m, b: cm.RigidBody("b", 1.0, 1.0, {"a": (0.0,)}),
+     "frames.a"),
+    ("make-law-unknown", lambda m, b: cm.make_law("hertzian", {}), "name"),
+    ("make-law-stiffness-negative",
+     lambda m, b: cm.make_law("hertz", {"stiffness": -1e9}), "stiffness"),
+    ("make-friction-unknown", lambda m, b: cm.make_friction("viscous", {}), "name"),
+    ("integrate-settings-str",
+     lambda m, b: cm.integrate(m.system, m.q0, m.qd0, 0.01, None, "RK45"), "settings"),
+    ("integrate-q0-short",
+     lambda m, b: cm.integrate(m.system, m.q0[:3], m.qd0, 0.01, None, cm.SolverSettings()),
+     "q0"),
     # scenes
     ("run-scene-out-dir-none", lambda m, b: cm.run_scene(torsion_scene(), None), "out_dir"),
     ("run-scene-scene-dict", lambda m, b: cm.run_scene({"torsion": {}}, "out"), "scene"),

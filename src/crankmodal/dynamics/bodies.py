@@ -65,6 +65,12 @@ class RigidBody:
         Interface frames in body coordinates (origin at the centre of mass), m and rad.
     z : float
         Axial position of the body's plane (row offset), m; used only for 3D moments.
+
+    Raises
+    ------
+    ParameterError
+        ``mass`` or ``inertia`` not finite and >= 0, a frame not 2 or 3 finite numbers, ``z``
+        not finite.
     """
 
     name: str
@@ -74,6 +80,21 @@ class RigidBody:
     z: float = 0.0
 
     ndof = 3
+
+    def __post_init__(self):
+        from .. import arguments as arg
+
+        self.mass = arg.number("mass", self.mass, ge=0.0)
+        self.inertia = arg.number("inertia", self.inertia, ge=0.0)
+        self.z = arg.number("z", self.z)
+        frames = arg.table("frames", self.frames, set(self.frames))
+        for key, value in frames.items():
+            value = arg.numbers(f"frames.{key}", value)
+            if len(value) not in (2, 3):
+                from ..errors import ParameterError
+
+                raise ParameterError(f"frames.{key}", f"must be (x, y) or (x, y, phi), got "
+                                     f"{len(value)} numbers")
 
     def local(self, frame: str) -> tuple[np.ndarray, float]:
         f = self.frames[frame]

@@ -40,24 +40,39 @@ import numpy as np
 from . import contact
 
 
+def _number(name: str, value) -> float:
+    from ..errors import ParameterError
+
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(name, f"must be a number; got {value!r}") from None
+
+
 def _positive(name: str, value) -> float:
-    v = float(value)
+    from ..errors import ParameterError
+
+    v = _number(name, value)
     if not (math.isfinite(v) and v > 0.0):
-        raise ValueError(f"{name} must be a finite number > 0; got {value!r}")
+        raise ParameterError(name, f"must be a finite number > 0; got {value!r}")
     return v
 
 
 def _non_negative(name: str, value) -> float:
-    v = float(value)
+    from ..errors import ParameterError
+
+    v = _number(name, value)
     if not (math.isfinite(v) and v >= 0.0):
-        raise ValueError(f"{name} must be a finite number >= 0; got {value!r}")
+        raise ParameterError(name, f"must be a finite number >= 0; got {value!r}")
     return v
 
 
 def _restitution(value) -> float:
-    v = float(value)
+    from ..errors import ParameterError
+
+    v = _number("restitution", value)
     if not (0.0 < v <= 1.0):
-        raise ValueError(f"restitution must be in (0, 1]; got {value!r}")
+        raise ParameterError("restitution", f"must be in (0, 1]; got {value!r}")
     return v
 
 
@@ -383,10 +398,13 @@ LAWS: dict[str, type[NormalLaw]] = {c.name: c for c in (
 
 
 def _build(registry, kind, name, params):
+    from ..errors import ParameterError
+
     try:
         cls = registry[name]
     except (KeyError, TypeError):
-        raise ValueError(f"unknown {kind} law {name!r}; known: {', '.join(registry)}") from None
+        raise ParameterError("name", f"unknown {kind} law {name!r}; known: "
+                             f"{', '.join(registry)}") from None
     params = dict(params or {})
     kw = {}
     for f in fields(cls):
@@ -394,7 +412,7 @@ def _build(registry, kind, name, params):
             kw[f.name] = params[f.name]
     missing = [f.name for f in fields(cls) if f.name not in kw and f.default is MISSING]
     if missing:
-        raise ValueError(f"{kind} law {name!r} needs parameter {missing[0]!r}")
+        raise ParameterError(missing[0], f"{kind} law {name!r} needs parameter {missing[0]!r}")
     return cls(**kw)
 
 
@@ -424,8 +442,9 @@ def make_law(name: str, params=None) -> NormalLaw:
 
     Raises
     ------
-    ValueError
-        Unknown name, a missing parameter, or an invalid value (naming it).
+    ParameterError
+        A ValueError naming ``name`` (unknown law), a missing parameter, or the parameter
+        whose value is invalid.
     """
     return _build(LAWS, "normal force", name, params)
 
@@ -535,8 +554,9 @@ def make_friction(name: str, params=None) -> FrictionLaw:
 
     Raises
     ------
-    ValueError
-        Unknown name, a missing parameter, or an invalid value (naming it).
+    ParameterError
+        A ValueError naming ``name`` (unknown law), a missing parameter, or the parameter
+        whose value is invalid.
 
     Examples
     --------

@@ -185,9 +185,7 @@ def _split(pins, clearance_specs, contact_kw):
                 wear_angle=spec.get("wear_angle", 0.0), viscosity=spec.get("viscosity"),
                 bearing_length=spec.get("bearing_length") or 0.0,
                 film_model=spec.get("film_model", "short"), **kw))
-        except ParameterError:
-            raise
-        except (ValueError, TypeError) as exc:  # the law objects' own checks
+        except (ValueError, TypeError) as exc:  # the law objects' own checks (ParameterError)
             where = f"clearances.{p.name}.contact" if spec.get("contact") else "contact_kw"
             raise ParameterError(where, f"joint {p.name!r}: {exc}"
                                  + _stiffness_hint(kw, spec)) from None

@@ -233,10 +233,16 @@ def exact_modes(chain: TorsionalChain) -> ChainModes:
 
     Raises
     ------
+    ParameterError
+        ``chain`` is not a TorsionalChain.
     NumericalError
         If a free-free chain's lowest eigenvalue is not zero to round-off.
     """
     from scipy.linalg import eigh
+
+    from .. import arguments as arg
+
+    arg.instance("chain", chain, TorsionalChain, "a TorsionalChain")
 
     K = chain.stiffness_matrix()
     w2, vecs = eigh(K, np.diag(chain.inertias))

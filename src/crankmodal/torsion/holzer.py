@@ -172,6 +172,9 @@ def holzer(chain: TorsionalChain, points_per_rotor: int = 400, max_refinements: 
 
     Raises
     ------
+    ParameterError
+        Naming ``chain`` (not a TorsionalChain), ``points_per_rotor`` (an integer in
+        [1, 1e5], and at most 1e8 grid points) or ``max_refinements`` (an integer in [0, 10]).
     NumericalError
         If the expected number of roots is not bracketed after the refinements.
 
@@ -186,6 +189,18 @@ def holzer(chain: TorsionalChain, points_per_rotor: int = 400, max_refinements: 
     """
     from scipy.optimize import brentq
 
+    from .. import arguments as arg
+
+    arg.instance("chain", chain, TorsionalChain, "a TorsionalChain")
+    points_per_rotor = arg.integer("points_per_rotor", points_per_rotor, ge=1, le=100_000)
+    max_refinements = arg.integer("max_refinements", max_refinements, ge=0, le=10)
+    if 2 * points_per_rotor * chain.n_rotors > 1e8:
+        from ..errors import ParameterError
+
+        raise ParameterError("points_per_rotor", f"{points_per_rotor} for {chain.n_rotors} "
+                             f"rotors is a sweep of {2 * points_per_rotor * chain.n_rotors:.3g} "
+                             f"points (8 bytes each, x4 per refinement); keep it <= 1e8, or use "
+                             "exact_modes")
     expected = chain.n_rotors - chain.n_rigid
     w_max = 1.02 * omega_upper_bound(chain)
     n_grid = max(2000, points_per_rotor * chain.n_rotors)

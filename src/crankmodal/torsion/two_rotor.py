@@ -93,6 +93,11 @@ def two_rotor(
         ``frequency_hz`` (Hz) and the node's position from the flywheel (fraction, and m when
         ``length`` is given).
 
+    Raises
+    ------
+    ParameterError
+        Naming an inertia or the stiffness not finite and > 0, or ``length`` not > 0.
+
     Examples
     --------
     Seed 004's two-rotor model (its flywheel, throw, ``G J / L_eq`` and ``L_eq``) gives its
@@ -103,7 +108,12 @@ def two_rotor(
     >>> print(f"{r.frequency_hz:.1f} Hz, node {1e3 * r.node_from_flywheel_m:.2f} mm")
     306.8 Hz, node 129.66 mm
     """
-    ia, ib = float(inertia_flywheel), float(inertia_other)
+    from .. import arguments as arg
+
+    ia = arg.number("inertia_flywheel", inertia_flywheel, gt=0.0)
+    ib = arg.number("inertia_other", inertia_other, gt=0.0)
+    stiffness = arg.number("stiffness", stiffness, gt=0.0)
+    length = arg.number("length", length, gt=0.0, optional=True)
     omega = np.sqrt(stiffness * (ia + ib) / (ia * ib))
     return TwoRotorResult(
         frequency_hz=float(omega / (2.0 * np.pi)),
