@@ -114,3 +114,53 @@ def test_a_crank_is_held_at_its_main_journals_only_and_overconstrained_bodies_gi
                        info={"interface_centres": centres})
     assert effective_damping(one, pinned=["a", "b"])["frequency_hz"] > 0.0
     assert effective_damping(one, pinned=["a", "b", "c"]) is None   # 6 rows hold x, y, θ, ξ
+
+
+def test_struck_pinned_beam_decays_at_the_effective_ratio_in_the_multibody_simulator():
+    """Time-domain oracle: the same beam in the multibody solver (Lagrange multipliers, the full
+    floating-frame equations), pinned at end0 and held across the line at end1, struck in its
+    first held mode at small amplitude: the log decrement of the first free-free coordinate's
+    peaks over 8 periods gives zeta within 1e-3 of the eigenvalue's (measured 6.8e-5) and the
+    damped frequency within 1e-4."""
+    import scipy.linalg as sla
+    from scipy.signal import find_peaks
+
+    from crankmodal.dynamics.bodies import Ground
+    from crankmodal.dynamics.joints import Revolute
+    from crankmodal.dynamics.modal_damping import constrained_matrices
+    from crankmodal.dynamics.simulate import SolverSettings, integrate
+    from crankmodal.dynamics.system import Multibody
+
+    body, *_ = _beam(0.02)
+
+    class Roller:
+        """end1 held in y only: the modes have no axial stretch, so a second x row (a pin)
+        would make the constraint Jacobian singular."""
+
+        name, n_eq = "B", 1
+
+        def blocks(self, sysm, t, q, qd):
+            p, J, bias = sysm.frame(body, "end1", q, qd)
+            return np.array([p[1]]), [(body, J[1:2])], np.zeros(1), -np.array([bias[1]])
+
+    ground = Ground("ground", {"p0": (0.0, 0.0)})
+    sysm = Multibody([body], [Revolute("A", ground, "p0", body, "end0"), Roller()])
+    M, C, K, N = constrained_matrices(body)
+    ev, V = sla.eigh(K, M)
+    i = int(np.argmax(ev > 1e-6 * ev.max()))
+    v = N @ V[:, i]
+    q0 = np.zeros(body.ndof)
+    q0[0] = 0.5                                    # centre of mass at midspan: ends at 0 and 1
+    period = 2 * np.pi / np.sqrt(ev[i])
+    t = np.linspace(0.0, 8 * period, 4001)
+    run = integrate(sysm, q0, 1e-4 * v / np.abs(v).max(), t[-1], t,
+                    SolverSettings(method="Radau", rtol=1e-9, atol=1e-13))
+    xi1 = run.y[3]
+    peaks, _ = find_peaks(xi1)
+    decay = -np.polyfit(t[peaks], np.log(xi1[peaks]), 1)[0]        # zeta omega_n, 1/s
+    omega_d = 2 * np.pi / np.mean(np.diff(t[peaks]))
+    zeta_td = decay / np.hypot(omega_d, decay)
+    e = effective_damping(body)
+    assert zeta_td == pytest.approx(e["damping_ratio"], rel=1e-3)
+    assert omega_d / (2 * np.pi) == pytest.approx(e["frequency_hz"] * np.sqrt(1 - zeta_td**2),
+                                                  rel=1e-4)
