@@ -292,3 +292,27 @@ def test_an_ensemble_shows_the_spread_of_an_impacting_run_and_none_of_a_smooth_o
     assert res["ensemble"]["per_trajectory"][0]["main_bearing_per_rev_peak_n"] == \
         res["statistics"]["main_bearing_force"]["per_rev_peak"]["mean"]     # the base run first
     assert "over 3 trajectories" in res["summary"]
+    # one headline value per quantity: the trajectories' mean, inside their range, said once
+    h = res["headline"]["main_bearing_per_rev_peak_n"]
+    values = [r["main_bearing_per_rev_peak_n"] for r in res["ensemble"]["per_trajectory"]]
+    assert h["value"] == pytest.approx(np.mean(values), rel=1e-12)   # same numbers, round-off
+    assert min(values) <= h["value"] <= max(values)
+    assert res["summary"].count("main-bearing per-rev peak") == 1
+
+
+def test_headline_takes_the_ensemble_spread_only_where_trajectories_disagree_beyond_their_sem():
+    # Issue 25 item 2: one value per quantity with its honest uncertainty. Hand-computed oracle:
+    # means 10 / 20 / 30 with standard errors 1 each disagree (std 10 > 1): 20 ± 10, spread;
+    # means 10.0 / 10.1 / 9.9 with standard errors 1 agree (std 0.1 < 1): the revolutions pool,
+    # 10 ± 1/sqrt(3), standard error; one trajectory: its own mean and standard error.
+    from crankmodal.dynamics.ensemble import headline_value
+
+    h = headline_value([10.0, 20.0, 30.0], [1.0, 1.0, 1.0])
+    assert h["value"] == pytest.approx(20.0) and h["uncertainty"] == pytest.approx(10.0)
+    assert h["basis"] == "ensemble spread" and (h["min"], h["max"]) == (10.0, 30.0)
+    h = headline_value([10.0, 10.1, 9.9], [1.0, 1.0, 1.0])
+    assert h["value"] == pytest.approx(10.0) and h["uncertainty"] == pytest.approx(1 / np.sqrt(3))
+    assert h["basis"] == "standard error" and h["spread"] == pytest.approx(0.1)
+    h = headline_value([7.0], [0.5])
+    assert (h["value"], h["uncertainty"], h["n_trajectories"]) == (7.0, 0.5, 1)
+
