@@ -70,3 +70,11 @@ def test_plain_numbers_switch_to_powers_of_ten_outside_a_readable_span():
     assert number(1.5e-13, 2) == "1.5 × 10⁻¹³"
     assert number(0.2688) == "0.2688" and number(123456.0) == "123500"
     assert number(math.nan) == "nan"
+
+
+def test_a_spread_takes_the_prefix_of_its_mean():
+    from crankmodal.report.quantity import quantity_as
+
+    assert quantity_as(1817.0, 16600.0, "N") == "1.817 kN"
+    assert quantity_as(0.3009, 6342.0, "N") == "0.3009 N"
+    assert quantity_as(9.018, 35.67, "") == "9.018"

@@ -197,3 +197,21 @@ def test_cancelled_forces_of_the_four_star_read_zero_not_piconewtons(mech_report
                   "shaking force with counterweight, max"):
         assert re.search(rf"{re.escape(label)}\s+0 N \(round-off\)", sec), label
     assert "pN" not in sec and "× 10⁻¹" not in sec
+
+
+def test_per_revolution_statistics_carry_units_with_the_spread_in_the_means_prefix():
+    from crankmodal.report.scene_report import _stat_rows
+
+    stats = {"window": {}, "main_bearing_force": {
+        "per_rev_peak": {"mean": 16600.0, "std": 3148.0, "sem": 1817.0},
+        "rms": {"mean": 4611.0, "std": 0.07437, "sem": 0.03326}},
+        "clearance_joints": {"big_end_1": {"impact_velocity": {
+            "count_per_rev": {"mean": 35.67, "std": 9.018, "sem": 5.207},
+            "max_per_rev": {"mean": 0.6244, "std": 0.2021, "sem": 0.1167}}}}}
+    rows = {r[0]: r[1:] for r in _stat_rows(stats)}
+    assert rows["main bearing force: per rev peak"] == ["16.6 kN", "3.148 kN", "1.817 kN"]
+    assert rows["main bearing force: rms"] == ["4611 N", "0.07437 N", "0.03326 N"]
+    assert rows["clearance joints: big end 1: impact velocity: count per rev"] == [
+        "35.67", "9.018", "5.207"]
+    assert rows["clearance joints: big end 1: impact velocity: max per rev"] == [
+        "0.6244 m/s", "0.2021 m/s", "0.1167 m/s"]

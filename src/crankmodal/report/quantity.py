@@ -6,6 +6,7 @@ One implementation for everything the report prints (tables, verdicts, stage sum
   without an SI prefix (rpm, %, °, kg, dimensionless) keeps its number plain (``1480 rpm``);
 - :func:`quantity_range` — ``15990, 34560, "N"`` -> ``15.99–34.56 kN`` (one prefix for both ends,
   an en dash; ``-120 to -40 N m`` when an end is negative, where a dash would read as a minus);
+- :func:`quantity_as` — a value with another's prefix (a spread beside its mean);
 - :func:`quantities` — a list with one prefix (``3631, 3669 N``);
 - :func:`percent` — a fraction as ``-12.1 %``;
 - :func:`number` — a plain number with ``digits`` significant digits and no ``e+04``; outside
@@ -106,6 +107,15 @@ def quantity(x, unit: str = "", digits: int = 4) -> str:
     e = _exponent(float(x), digits)
     if e is None:
         return f"{number(x, digits)} {unit}"
+    return f"{_fixed(float(x) / 10.0 ** e, digits)} {PREFIXES[e]}{unit}"
+
+
+def quantity_as(x, reference, unit: str = "", digits: int = 4) -> str:
+    """``x`` with the prefix :func:`quantity` gives ``reference``: a spread beside its mean
+    (``quantity_as(0.3009, 6342, "N")`` -> ``0.3009 N``, not ``300.9 mN``)."""
+    e = _exponent(float(reference), digits) if unit in PREFIXABLE else None
+    if e is None:
+        return quantity(x, unit, digits)
     return f"{_fixed(float(x) / 10.0 ** e, digits)} {PREFIXES[e]}{unit}"
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .modal_report import _MIME, Report
-from .quantity import percent, quantities, quantity, quantity_range
+from .quantity import percent, quantities, quantity, quantity_as, quantity_range
 
 #: sections drawn by :func:`crankmodal.report.modal_report.modal_blocks` (the FE part's modes)
 MODAL_SECTIONS = ("geometry", "material", "modal")
@@ -364,6 +364,18 @@ def dynamics_blocks(report: Report, res: dict) -> None:
         report.table(["quantity", "mean", "std", "standard error"], srows)
 
 
+def statistic_unit(name: str) -> str:
+    """The SI unit of a per-revolution statistic from its path (``main bearing force: rms`` ->
+    N); '' for counts and what the path does not tell."""
+    if "count" in name:
+        return ""
+    for word, unit in (("moment", "N m"), ("torque", "N m"), ("force", "N"),
+                       ("acceleration", "m/s²"), ("velocity", "m/s"), ("penetration", "m")):
+        if word in name:
+            return unit
+    return ""
+
+
 def _stat_rows(stats: dict, prefix: str = ""):
     """Rows for every scalar ``{mean, std, sem}`` leaf of a statistics block (any depth; the
     per-order vectors stay in results.json)."""
@@ -373,7 +385,10 @@ def _stat_rows(stats: dict, prefix: str = ""):
         name = f"{prefix}{key}".replace("_", " ")
         if "mean" in v:
             if isinstance(v["mean"], (int, float)):
-                yield [name, fmt(v.get("mean")), fmt(v.get("std")), fmt(v.get("sem"))]
+                unit, mean = statistic_unit(name), v["mean"]
+                yield [name, fmt(mean, unit)] + [
+                    None if v.get(k) is None else quantity_as(v[k], mean, unit)
+                    for k in ("std", "sem")]
         else:
             yield from _stat_rows(v, f"{prefix}{key}: ")
 
