@@ -87,7 +87,7 @@ def test_pinned_pinned_beam_effective_damping_is_the_projection_of_its_free_free
 def test_one_pin_leaves_the_swing_free_and_reports_the_first_cantilever_like_mode():
     """Pinned at one end only the beam swings freely about the pin (a zero root, left out);
     the lowest oscillating mode is the pinned-free one (beta L = 3.9266, tan bL = tanh bL)."""
-    body, betas, phis = _beam(0.02)
+    body, *_ = _beam(0.02)
     e = effective_damping(body, pinned=["end0"])
     beta = brentq(lambda b: np.tan(b) - np.tanh(b), 3.8, 3.95)
     assert e["frequency_hz"] == pytest.approx(beta**2 / (2 * np.pi), rel=2e-3)
@@ -145,7 +145,7 @@ def test_struck_pinned_beam_decays_at_the_effective_ratio_in_the_multibody_simul
 
     ground = Ground("ground", {"p0": (0.0, 0.0)})
     sysm = Multibody([body], [Revolute("A", ground, "p0", body, "end0"), Roller()])
-    M, C, K, N = constrained_matrices(body)
+    M, _, K, N = constrained_matrices(body)
     ev, V = sla.eigh(K, M)
     i = int(np.argmax(ev > 1e-6 * ev.max()))
     v = N @ V[:, i]
