@@ -58,8 +58,17 @@ def _closed_forms(q):
     return deflection, stress
 
 
+PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9, "m": 1e-3, "µ": 1e-6}
+
+
 def _number(pattern, text):
     return float(re.search(pattern, text).group(1))
+
+
+def _si(pattern, text):
+    """A quantity the text prints with an engineering prefix (``23.72 mm``), in SI units."""
+    value, prefix = re.search(pattern, text).groups()
+    return float(value) * PREFIX[prefix]
 
 
 def test_a_bent_coupler_beyond_2_percent_and_yield_is_warned_with_the_closed_form_numbers(coupler):
@@ -82,13 +91,15 @@ def test_a_bent_coupler_beyond_2_percent_and_yield_is_warned_with_the_closed_for
     bend, stress = texts
     assert bend.startswith("dynamics.flexible.coupler: coupler deflects")
     # the numbers the warnings quote, against the closed forms
-    assert _number(r"deflects ([\d.]+) mm", bend) == pytest.approx(1e3 * d_ref, rel=0.02)
+    assert _si(r"deflects ([\d.]+) (\w?)m elastically", bend) == pytest.approx(d_ref, rel=0.02)
     assert _number(r", ([\d.]+) % of its 75 mm interface span", bend) == \
         pytest.approx(100 * d_ref / L, rel=0.02)
     assert f"warning above {100 * DEFLECTION_FRACTION:g} %" in bend
-    assert _number(r"reaches ([\d.e+]+) MPa", stress) == pytest.approx(s_ref / 1e6, rel=0.02)
-    assert _number(r"MPa \(von Mises, from its stress modes\), ([\d.]+) times", stress) == \
+    assert _si(r"reaches ([\d.]+) (\w?)Pa", stress) == pytest.approx(s_ref, rel=0.02)
+    assert _number(r"Pa \(von Mises, from its stress modes\), ([\d.]+) times", stress) == \
         pytest.approx(s_ref / YIELD, rel=0.02)
+    assert "yield strength 355 MPa of steel" in stress
+    assert "e+" not in bend + stress                                  # issue 25 #15
 
 
 def test_a_coupler_well_inside_its_limits_is_not_warned(coupler):
@@ -141,5 +152,8 @@ def test_the_slender_coupler_at_20000_rpm_is_warned_and_at_450_rpm_not(tmp_path)
     # item 13: the coupler's lowest mode held at its joints, stated in results and summary
     e = slow["flexible"]["bodies"]["coupler"]["effective_damping"]
     assert e["pinned"] == ["end_x0", "end_x1"] and e["given_ratio"] == 0.02
-    assert f"coupler {e['frequency_hz']:.4g} Hz held at end_x0, end_x1, effective damping " \
-           f"{e['damping_ratio']:.2g} (0.02 given on its free-free modes)" in slow["summary"]
+    from crankmodal.report.quantity import number, quantity
+
+    assert f"coupler {quantity(e['frequency_hz'], 'Hz')} held at end_x0, end_x1, effective " \
+           f"damping {number(e['damping_ratio'], 2)} (0.02 given on its free-free modes)" \
+        in slow["summary"]

@@ -331,8 +331,11 @@ def convergence_tag(c: dict, at: int, rel_tol: float = REL_TOL) -> str:
 
 
 def _pct(x: float) -> str:
-    """A relative number in percent: two significant digits, whole percent from 10 %."""
-    return f"{100 * x:.0f}" if 100 * x >= 10 else f"{100 * x:.2g}"
+    """A relative number in percent: two significant digits, whole percent from 10 %, never
+    ``e-05`` (:func:`crankmodal.report.quantity.number`)."""
+    from ..report.quantity import number
+
+    return f"{100 * x:.0f}" if 100 * x >= 10 else number(100 * x, 2)
 
 
 def _by_how_much(c: dict, at: int, rel_tol: float) -> str:

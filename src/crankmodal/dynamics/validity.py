@@ -222,23 +222,26 @@ def flexible_validity(body, deflection: dict | None, stress: dict | None, key: s
              "deflection_time_s": None if deflection is None else deflection["time_s"],
              "max_von_mises_pa": sv, "material": mat, "yield_strength_pa": sy,
              "stress_checked": sv is not None and sy is not None}
+    from ..report.quantity import number, quantity  # engineering prefixes, never e+NN
+
     out = []
     name = body.name
     if frac is not None and frac > fraction:
-        out.append(f"{key}: {name} deflects {1e3 * d:.3g} mm elastically ({deflection['where']}),"
-                   f" {100 * frac:.3g} % of its {1e3 * size:.3g} mm {size_of} (warning above "
-                   f"{100 * fraction:g} %): the linear floating-frame model (small deformation, "
-                   f"no geometric stiffening) no longer holds and its forces, deflections and "
-                   f"stresses are outside the model's validity")
+        out.append(f"{key}: {name} deflects {quantity(d, 'm')} elastically "
+                   f"({deflection['where']}), {number(100 * frac, 3)} % of its "
+                   f"{quantity(size, 'm')} {size_of} (warning above {100 * fraction:g} %): the "
+                   f"linear floating-frame model (small deformation, no geometric stiffening) no "
+                   f"longer holds and its forces, deflections and stresses are outside the "
+                   f"model's validity")
     if sv is not None and sy is not None and sv > sy:
-        out.append(f"{key}: {name}'s dynamic stress reaches {sv / 1e6:.4g} MPa (von Mises, "
-                   f"from its stress modes), {sv / sy:.3g} times the yield strength "
-                   f"{sy / 1e6:.4g} MPa of {mat}: a linear-elastic body would have yielded, the "
-                   f"model does not hold")
+        out.append(f"{key}: {name}'s dynamic stress reaches {quantity(sv, 'Pa')} (von Mises, "
+                   f"from its stress modes), {number(sv / sy, 3)} times the yield strength "
+                   f"{quantity(sy, 'Pa')} of {mat}: a linear-elastic body would have yielded, "
+                   f"the model does not hold")
     elif sv is not None and sy is None:
         why = (f"the material library has no yield strength for {mat!r}" if mat
                else "its file names no material")
-        out.append(f"{key}: {name}'s dynamic stress ({sv / 1e6:.4g} MPa von Mises) is not "
+        out.append(f"{key}: {name}'s dynamic stress ({quantity(sv, 'Pa')} von Mises) is not "
                    f"checked against a yield strength: {why}")
     block["inside"] = not any(w for w in out if "not checked" not in w)
     return block, out
@@ -250,21 +253,25 @@ def validity_summary(bodies: dict) -> str:
     the model's validity.
 
     ``bodies``: results ``dynamics.flexible.bodies`` (``validity``, ``effective_damping``)."""
+    from ..report.quantity import number, quantity  # never e+NN in a summary
+
     parts, bad = [], []
     for name, d in bodies.items():
         e = d.get("effective_damping")
         if e:
-            parts.append(f"{name} {e['frequency_hz']:.4g} Hz held at {', '.join(e['pinned'])}, "
-                         f"effective damping {e['damping_ratio']:.2g} ({e['given_ratio']:g} "
+            parts.append(f"{name} {quantity(e['frequency_hz'], 'Hz')} held at "
+                         f"{', '.join(e['pinned'])}, effective damping "
+                         f"{number(e['damping_ratio'], 2)} ({number(e['given_ratio'], 3)} "
                          f"given on its free-free modes)")
         v = d.get("validity") or {}
         why = []
         if v.get("deflection_fraction") is not None and \
                 v["deflection_fraction"] > v["deflection_limit_fraction"]:
-            why.append(f"deflects {100 * v['deflection_fraction']:.3g} % of its {v['size_of']}")
+            why.append(f"deflects {number(100 * v['deflection_fraction'], 3)} % of its "
+                       f"{v['size_of']}")
         if v.get("stress_checked") and v["max_von_mises_pa"] > v["yield_strength_pa"]:
-            why.append(f"stress {v['max_von_mises_pa'] / 1e6:.4g} MPa > yield "
-                       f"{v['yield_strength_pa'] / 1e6:.4g} MPa")
+            why.append(f"stress {quantity(v['max_von_mises_pa'], 'Pa')} > yield "
+                       f"{quantity(v['yield_strength_pa'], 'Pa')}")
         if why:
             bad.append(f"{name} " + " and ".join(why))
     out = "; lowest modes: " + ", ".join(parts) if parts else ""
