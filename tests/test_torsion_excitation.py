@@ -48,6 +48,38 @@ def test_single_compressor_cylinder_mean_effort_times_omega_is_indicated_power_1
     assert power == pytest.approx(work * m.speed_rpm / 60.0, rel=1e-6)
 
 
+def _ideal_cycle_work(ps, pd, n, swept, eps):
+    """Closed-form p-V work of the ideal polytropic compressor cycle (equal exponents), J."""
+    v1, v4 = swept * (1 + eps), swept * eps * (pd / ps) ** (1 / n)
+    return n / (n - 1) * ps * (v1 - v4) * ((pd / ps) ** ((n - 1) / n) - 1)
+
+
+def test_double_acting_cylinder_mean_power_is_both_ends_ideal_cycles_1e6(oracle):
+    from crankmodal.torsion.excitation import CrankEnd
+
+    r, lam, n_exp = 0.06, 0.25, 1.3
+    ps, pd, eps, eps_ce, d_rod = 1.0e5, 4.0e5, 0.06, 0.09, 0.04
+    cyl = Cylinder(0.0, 0.0, 0.0, piston_mass=5.0, bore=0.12, suction_pressure=ps,
+                   discharge_pressure=pd, relative_clearance=eps)
+    m = Machine("c", r, _rod(r / lam, 2.0), 1000.0, (cyl,), gas=CompressorGas(n_exp, n_exp, 1.0, "pressure"))
+    eff = cylinder_efforts(m, n_per_rev=20000, crank_ends=(CrankEnd(0, d_rod, eps_ce),))
+    power = abs(eff.mean_torque(m.omega)[0]) * m.omega
+    stroke = 2 * r
+    work = (_ideal_cycle_work(ps, pd, n_exp, cyl.area * stroke, eps)
+            + _ideal_cycle_work(ps, pd, n_exp, (cyl.area - math.pi * d_rod**2 / 4) * stroke, eps_ce))
+    oracle(stage="torsion", quantity="mean effort x omega, double-acting compressor cylinder",
+           reference="closed-form ideal cycles of head and crank end", tolerance="1e-6 rel",
+           measured=power, expected=work * m.speed_rpm / 60.0)
+    assert power == pytest.approx(work * m.speed_rpm / 60.0, rel=1e-6)
+    # the crank end works half a turn after the head end: order 1 of the gas torque nearly cancels
+    single = cylinder_efforts(m, n_per_rev=720)
+    g1, _ = single.cylinder_harmonics(2)
+    g2, _ = cylinder_efforts(m, n_per_rev=720, crank_ends=(CrankEnd(0, d_rod, eps_ce),)).cylinder_harmonics(2)
+    assert abs(g2[0, 0]) < 0.5 * abs(g1[0, 0])
+    with pytest.raises(ParameterError, match="rod_diameter"):
+        cylinder_efforts(m, crank_ends=(CrankEnd(0, 0.12),))
+
+
 @pytest.mark.parametrize("lam", [0.1, 0.2])
 def test_inertia_torque_orders_match_series_in_lambda(lam, oracle):
     # T = -m a dx/dpsi = -(m/2) d(v^2)/dpsi with v/(r omega) = sin t + lam sin t cos t (1 - lam^2

@@ -131,6 +131,8 @@ def test_seed004_train_study_writes_contract_fields_figures_and_report(tmp_path)
      "torsion.forced.sections[0].bore"),
     ("torsion.forced.operating_speeds_rpm=[1900.0]", "torsion.forced.operating_speeds_rpm[0]"),
     ("torsion.forced.speed_band=0.5", "torsion.forced.speed_band"),
+    ("torsion.forced.double_acting=[{cylinder=1, rod_diameter=0.2}]", "torsion.forced.double_acting[0].rod_diameter"),
+    ("torsion.forced.double_acting=[{cylinder=3, rod_diameter=0.03}]", "torsion.forced.double_acting[0].cylinder"),
 ])
 def test_bad_forced_input_exits_2_with_one_line_naming_the_key(tmp_path, override, key):
     p = run_cli("run", SEED, "--out", tmp_path, "--set", override)

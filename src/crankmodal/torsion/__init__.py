@@ -15,6 +15,17 @@ Modules, one concept each:
 - :mod:`.critical_speeds` -- orders x running speed against natural frequencies;
 - :mod:`.fe_compare` -- the first FE torsional mode (as the FE classifier names it) beside the
   lumped-chain frequencies;
+- :mod:`.excitation` -- each cylinder's tangential effort from the mechanism, its orders, and the
+  harmonic torques on the rotors (the machine's arrangement: :mod:`crankmodal.mechanism.arrangement`);
+- :mod:`.damping` -- rotor, section and modal damping, dampers as chain elements;
+- :mod:`.forced` -- the damped train, per-order steady state and its phased synthesis, the
+  energy-balance resonance amplitude;
+- :mod:`.stress` -- section modulus, nominal shear stress, allowable vibratory stress;
+- :mod:`.verdict` -- separation margins of significant orders and the stress check;
+- :mod:`.resonance` -- Holzer-style tables at the resonances of a forced train;
+- :mod:`.fe_beside` -- the FE crank's torsional modes beside the forced train's;
+- :mod:`.forced_stage`, :mod:`.forced_plots`, :mod:`.forced_report` -- ``[torsion.forced]``, its
+  figures and its report tables;
 - :mod:`.plots` -- PNG figures (matplotlib imported inside the functions);
 - :mod:`.stage` -- the ``[torsion]`` scene section.
 

@@ -90,6 +90,75 @@ class PressureTable:
                                   2.0 * math.pi * self.cycle_revolutions)
 
 
+@dataclass(frozen=True)
+class CrankEnd:
+    """The crank-end chamber of a double-acting (compressor) cylinder.
+
+    The piston rod passes through it, so its working area is the piston area less the rod's;
+    its gas cycle is the head end's half a revolution later, on its own displacement
+    ``stroke - x``. Its force on the piston points away from the crank.
+
+    Attributes
+    ----------
+    cylinder : int
+        0-based cylinder.
+    rod_diameter : float
+        Piston-rod diameter, m (< bore).
+    relative_clearance : float or None
+        Crank-end clearance / its swept volume; default the cylinder's (head-end) value.
+    """
+
+    cylinder: int
+    rod_diameter: float
+    relative_clearance: float | None = None
+
+    def __post_init__(self):
+        if not (math.isfinite(self.rod_diameter) and self.rod_diameter > 0):
+            raise ParameterError("rod_diameter", f"must be > 0 (m), got {self.rod_diameter!r}")
+        if self.relative_clearance is not None and not 0 < self.relative_clearance < 1:
+            raise ParameterError("relative_clearance", f"must be in (0, 1), got {self.relative_clearance!r}")
+
+
+def crank_end_torque(machine, crank_end: CrankEnd, psi, pressure_table=None):
+    """Crank torque of a crank-end chamber (N m) at cylinder angles ``psi`` (rad, from its head
+    end's top dead centre), from the machine's compressor cycle or a 360 deg pressure table.
+
+    Raises
+    ------
+    ParameterError
+        ``rod_diameter`` not below the bore, ``cylinder`` out of range, or a machine whose gas is
+        not a compressor cycle (and no 360 deg table).
+    """
+    from ..mechanism import forces as fo
+    from ..mechanism import gas as ga
+    from ..mechanism.kinematics import exact_motion, kinematic_ratio
+    from ..mechanism.machine import CompressorGas
+
+    if not 0 <= crank_end.cylinder < len(machine.cylinders):
+        raise ParameterError("cylinder", f"must be 1..{len(machine.cylinders)}, got {crank_end.cylinder + 1}")
+    c = machine.cylinders[crank_end.cylinder]
+    if not crank_end.rod_diameter < c.bore:
+        raise ParameterError("rod_diameter", f"must be < the bore ({c.bore:g} m), got {crank_end.rod_diameter:g}")
+    area = c.area - math.pi * crank_end.rod_diameter**2 / 4.0
+    r, lam = machine.crank_radius, machine.ratio
+    stroke = 2.0 * r
+    if pressure_table is not None:
+        if pressure_table.cycle_revolutions != 1:
+            raise ParameterError("cylinder", "a double-acting cylinder needs a 360 deg cycle")
+        p = pressure_table.pressure(psi - math.pi)
+    elif isinstance(machine.gas, CompressorGas):
+        g = machine.gas
+        eps = c.relative_clearance if crank_end.relative_clearance is None else crank_end.relative_clearance
+        x_ce = stroke - exact_motion(psi, r, lam, 1.0).x  # crank-end displacement from its own TDC
+        p = ga.compressor_pressure(psi - math.pi, x_ce, stroke, c.suction_pressure, c.discharge_pressure,
+                                   eps, g.compression_exponent, g.expansion_exponent,
+                                   g.pressure_coefficient, g.valve_timing, g.seed_angles)
+    else:
+        raise ParameterError("cylinder", "double acting needs the compressor gas model or a 360 deg "
+                             "pressure table")
+    return fo.crank_torque(-ga.gas_force(p, area, machine.atmospheric_pressure), kinematic_ratio(psi, r, lam))
+
+
 @dataclass
 class CylinderEfforts:
     """Crank torque of each cylinder over one working cycle, split by speed dependence.
@@ -161,7 +230,7 @@ class CylinderEfforts:
 
 
 def cylinder_efforts(machine, arrangement=None, pressure_table: PressureTable | None = None,
-                     n_per_rev: int = 720) -> CylinderEfforts:
+                     n_per_rev: int = 720, crank_ends=()) -> CylinderEfforts:
     """Each cylinder's crank torque over one working cycle, from the mechanism.
 
     Parameters
@@ -175,6 +244,8 @@ def cylinder_efforts(machine, arrangement=None, pressure_table: PressureTable | 
         cylinder's firing TDC).
     n_per_rev : int
         Crank-angle samples per revolution.
+    crank_ends : sequence of CrankEnd
+        Double-acting cylinders: their crank-end chambers' torque is added to the gas part.
 
     Returns
     -------
@@ -220,6 +291,12 @@ def cylinder_efforts(machine, arrangement=None, pressure_table: PressureTable | 
                                  f"{360 * machine.cycle_revolutions} deg cycle, not {360 * cr} deg")
         full = analyse(machine, n_per_rev).cylinder_torque
         gas = full - machine.omega**2 * inertia
+    for i, ce in enumerate(crank_ends):
+        if ce.cylinder in [e.cylinder for e in crank_ends[:i]]:
+            raise ParameterError("cylinder", f"cylinder {ce.cylinder + 1} is listed twice")
+        c = cyl[ce.cylinder] if 0 <= ce.cylinder < len(cyl) else None
+        psi_c = theta + (c.throw_angle - c.bank_angle if c is not None else 0.0)
+        gas[:, ce.cylinder] += crank_end_torque(machine, ce, psi_c, pressure_table)
     return CylinderEfforts(theta=theta, cycle_revolutions=cr, crank_radius=machine.crank_radius,
                            gas_torque=gas, inertia_torque_unit=inertia, cylinder_throws=throws)
 

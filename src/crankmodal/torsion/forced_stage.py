@@ -38,6 +38,8 @@ SCHEMA: dict[str, Field] = {
     "cylinder_throws": Field("ints", None, "throw (1-based) of each [mechanism] cylinder (default: one each)", ge=1),
     "firing_order": Field("ints", None, "four-stroke: cylinders (1-based) in firing order", ge=1),
     "pressure_table": Field("table", None, "measured cylinder pressure: angle_deg, pressure_pa, cycle_deg"),
+    "double_acting": Field("tables", [], "double-acting cylinders {cylinder (1-based), rod_diameter (m), "
+                           "relative_clearance of the crank end}"),
     "n_points": Field("int", 720, "crank-angle samples per revolution of the excitation", ge=72, le=20000),
     "rotor_damping": Field("floats", None, "absolute damping of each rotor, N m s/rad", ge=0.0),
     "section_damping": Field("floats", None, "relative damping across each shaft section, N m s/rad", ge=0.0),
@@ -75,6 +77,12 @@ SECTION = {
     "section_modulus": Field("float", None, "polar section modulus Z_p, m^3 (instead of diameter)", gt=0.0),
     "stress_concentration": Field("float", 1.0, "K_t", ge=1.0),
     "name": Field("str", None, "label"),
+}
+CRANK_END = {
+    "cylinder": Field("int", doc="[mechanism] cylinder, 1-based", ge=1),
+    "rod_diameter": Field("float", doc="piston-rod diameter, m", gt=0.0),
+    "relative_clearance": Field("float", None, "crank-end clearance / its swept volume (default: the cylinder's)",
+                                gt=0.0, lt=1.0),
 }
 PRESSURE = {
     "angle_deg": Field("floats", doc="crank angle from firing TDC (four-stroke) or TDC, deg, increasing, "
@@ -149,7 +157,7 @@ def validate(tp: dict, scene, chain, model) -> dict:
     """
     from ..mechanism.arrangement import arrangement_of_machine
     from .damping import Damper
-    from .excitation import PressureTable, cylinder_efforts, rotor_excitation
+    from .excitation import CrankEnd, PressureTable, cylinder_efforts, rotor_excitation
     from .forced import damped_train
     from .stress import Allowable
 
@@ -182,8 +190,8 @@ def validate(tp: dict, scene, chain, model) -> dict:
         if machine is None:
             raise SceneError(f"{KEY}.throw_rotors: the machine's excitation needs a [mechanism] section in the scene")
     else:
-        for k in ("cylinder_throws", "firing_order", "pressure_table"):
-            if f[k] is not None:
+        for k in ("cylinder_throws", "firing_order", "pressure_table", "double_acting"):
+            if f[k]:
                 raise SceneError(f"{KEY}.{k}: needs throw_rotors (and a [mechanism] section)")
         if not f["harmonics"]:
             raise SceneError(f"{KEY}.harmonics: give harmonic torques, or throw_rotors with a [mechanism] section")
@@ -202,7 +210,24 @@ def validate(tp: dict, scene, chain, model) -> dict:
                 machine, None if f["cylinder_throws"] is None else [t - 1 for t in f["cylinder_throws"]],
                 None if f["firing_order"] is None else [c - 1 for c in f["firing_order"]],
                 cycle_revolutions=cr)
-            efforts = cylinder_efforts(machine, arrangement, table, f["n_points"])
+        ends: list = []
+        for i, d in enumerate(f["double_acting"]):
+            key = f"{KEY}.double_acting[{i}]"
+            d = validate_table(key, d, CRANK_END)
+            n_cyl = len(machine.cylinders)
+            if d["cylinder"] > n_cyl or d["cylinder"] - 1 in [e.cylinder for e in ends]:
+                raise SceneError(f"{key}.cylinder: must be one of the cylinders 1..{n_cyl}, each once, "
+                                 f"got {d['cylinder']}")
+            bore = machine.cylinders[d["cylinder"] - 1].bore
+            if not d["rod_diameter"] < bore:
+                raise SceneError(f"{key}.rod_diameter: must be < the bore ({bore:g} m), got {d['rod_diameter']:g}")
+            if (table is None and getattr(machine.gas, "kind", None) != "compressor") or (table and cr != 1):
+                raise SceneError(f"{key}.cylinder: double acting needs mechanism.gas.model = 'compressor' "
+                                 "or a 360 deg pressure_table")
+            with scene_keys(key):
+                ends.append(CrankEnd(d["cylinder"] - 1, d["rod_diameter"], d["relative_clearance"]))
+        with scene_keys(KEY):
+            efforts = cylinder_efforts(machine, arrangement, table, f["n_points"], tuple(ends))
     harmonics = [{**h, "rotor": h["rotor"] - 1} for h in f["harmonics"]]
     with scene_keys(KEY):
         excitation = rotor_excitation(
