@@ -120,14 +120,16 @@ def _label(key: str) -> str:
 def headline_text(block: dict, n_revolutions: int) -> str:
     """The summary line's numbers: each quantity once, ``value ± uncertainty``, marked
     ``(spread)`` where the uncertainty is the trajectory-to-trajectory spread."""
+    from ..report.quantity import number
+
     parts = []
     n_traj = 1
     for key, h in block.items():
         k = 1e3 if abs(h["value"]) >= 1e4 and h["unit"] in ("N", "m/s^2") else 1.0
         unit = ("k" if k > 1 else "") + (h["unit"] if h["unit"] != "1/rev" else "")
-        text = f"{_label(key)} {h['value'] / k:.4g}"
+        text = f"{_label(key)} {number(h['value'] / k)}"  # never e+NN (issue 25 #15)
         if h["uncertainty"] > 0.0:
-            text += f" ± {h['uncertainty'] / k:.2g}"
+            text += f" ± {number(h['uncertainty'] / k, 2)}"
         parts.append((text + (f" {unit}" if unit else "")
                       + (" (spread)" if h["basis"] == "ensemble spread" else "")))
         n_traj = h["n_trajectories"]

@@ -344,6 +344,8 @@ def run(params: dict, ctx) -> dict:
         motion = f"piston accel peak {k['peak_piston_acceleration']:.4g} m/s^2"
     else:
         motion = f"rocker accel peak {res['angular_acceleration_peak'].get('rocker', 0.0):.4g} rad/s^2"
+    from ..report.quantity import number, quantity  # never e+NN in a summary (issue 25 #15)
+
     if "ensemble" in res and n_rev >= 1 and study is None:
         # one value per quantity, with the ensemble's spread where the trajectories disagree
         # (with a tolerance study: its convergence summary over the ensemble, below)
@@ -355,9 +357,11 @@ def run(params: dict, ctx) -> dict:
         headline_text = converged_summary(res["statistics"], study, settings.rtol,
                                           res.get("ensemble", {}).get("n_trajectories"))
     else:
-        headline_text = f"main-bearing peak {res['main_bearing_force_peak_n']:.4g} N, {motion}"
+        headline_text = (f"main-bearing peak {quantity(res['main_bearing_force_peak_n'], 'N')}, "
+                         f"{motion}")
     res["summary"] = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {t_end:g} s: {headline_text}, "
-                      f"{n_imp} impacts, energy balance {res['energy_balance_error']:.1e}")
+                      f"{n_imp} impacts, energy balance "
+                      f"{number(res['energy_balance_error'], 2)}")
     for name, j in joints.items():
         if "min_film_thickness_m" in j:
             res["summary"] += (f"; {name} oil film: thinnest {1e6 * j['min_film_thickness_m']:.3g}"

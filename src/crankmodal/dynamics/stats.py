@@ -332,8 +332,10 @@ def headline(stats: dict) -> dict:
 
 def _fmt(value: float, sem: float, unit: str) -> str:
     """``18.3 ± 0.9 kN``: value and standard error with a k prefix above 1e4."""
+    from ..report.quantity import number  # no 6.3e+02 beside 4863 (issue 25 #15)
+
     k = 1e3 if abs(value) >= 1e4 else 1.0
-    return f"{value / k:.4g} ± {sem / k:.2g} {'k' if k > 1 else ''}{unit}"
+    return f"{number(value / k)} ± {number(sem / k, 2)} {'k' if k > 1 else ''}{unit}"
 
 
 def converged_summary(stats: dict, study: dict | None = None, rtol: float | None = None,
