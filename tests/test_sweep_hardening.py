@@ -355,3 +355,14 @@ def test_log_axis_values_keep_their_digits_and_lose_the_noise():
     exact = 2e-5 * 10 ** (np.arange(4) / 3)
     assert np.allclose(g.values, exact, rtol=1e-9, atol=0)
     assert g.values[0] == 2e-5 and g.values[-1] == 2e-4
+
+
+@pytest.mark.parametrize("workers", [0, -1, 1.5, True])
+def test_bad_worker_count_from_python_is_one_error_naming_it(tmp_path, workers):
+    """run_sweep(workers=-1) waited forever for a cluster of -1 workers; 0 meant the CPU count."""
+    from crankmodal.errors import ParameterError
+
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n[axes]\nmechanism.speed_rpm = [900]\n")
+    with pytest.raises(ParameterError, match=r"^workers: must be an integer >= 1, got "):
+        run_sweep(sw, tmp_path / "o", workers=workers)
+    assert not (tmp_path / "o").exists()

@@ -22,7 +22,7 @@ import threading
 import time
 from pathlib import Path
 
-from ..errors import CrankmodalError
+from ..errors import CrankmodalError, ParameterError
 from ..results import make_out_dir, write_json_atomic
 from .execute import build_scene, execute_point, overrides_of, point_key
 from .spec import SweepSpec, check_max_failed, load_sweep
@@ -383,6 +383,9 @@ def run_sweep(spec, out_dir, client=None, *, scheduler: str | None = None,
         Ctrl-C or SIGTERM: the cluster is closed, the finished points' records are kept.
     """
     t0 = time.perf_counter()
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise ParameterError("workers", f"must be an integer >= 1, got {workers!r}")
     spec = spec if isinstance(spec, SweepSpec) else load_sweep(spec)
     share = spec.max_failed if max_failed is None else check_max_failed("max_failed", max_failed)
     out_dir = Path(out_dir)
