@@ -157,3 +157,25 @@ def test_the_slender_coupler_at_20000_rpm_is_warned_and_at_450_rpm_not(tmp_path)
     assert f"coupler {quantity(e['frequency_hz'], 'Hz')} held at end_x0, end_x1, effective " \
            f"damping {number(e['damping_ratio'], 2)} (0.02 given on its free-free modes)" \
         in slow["summary"]
+
+
+def test_an_api_run_is_checked_the_same_way(coupler):
+    """check_flexible_bodies: a History-like record (times, modal coordinates, crank angle) of
+    the loaded coupler is warned with a ModelWarning naming the scene table, and the same block
+    as flexible_validity's."""
+    from types import SimpleNamespace
+
+    from crankmodal.dynamics.validity import check_flexible_bodies
+    from crankmodal.errors import ModelWarning
+
+    modal, q = _static_state(coupler, 3e6)
+    hist = SimpleNamespace(t=np.array([0.0, 1e-3]), modal={"coupler": modal},
+                           crank_angle=np.zeros(2))
+    coupler.name = "coupler"
+    mech = SimpleNamespace(system=SimpleNamespace(bodies=[coupler]))
+    kept = []
+    with pytest.warns(ModelWarning, match="dynamics.flexible.coupler: coupler deflects"):
+        blocks = check_flexible_bodies(mech, hist, warnings=kept)
+    d_ref, _ = _closed_forms(q)
+    assert blocks["coupler"]["deflection_max_m"] == pytest.approx(d_ref, rel=0.02)
+    assert len(kept) == 2 and blocks["coupler"]["inside"] is False

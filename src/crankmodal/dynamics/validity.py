@@ -279,3 +279,30 @@ def validity_summary(bodies: dict) -> str:
         out += ("; OUTSIDE THE LINEAR FLEXIBLE MODEL'S VALIDITY: " + "; ".join(bad)
                 + " (results warnings)")
     return out
+
+
+def check_flexible_bodies(mech, hist, t_start: float = 0.0, warnings: list | None = None) -> dict:
+    """The flexible-body checks of a run made with the Python API (:func:`.analysis.simulate`),
+    as a scene run makes them: each flexible body's :func:`flexible_validity` block over the
+    samples from ``t_start`` (s) on, its warnings issued as :class:`~crankmodal.errors.ModelWarning`
+    (and appended to ``warnings`` if given).
+
+    Returns
+    -------
+    dict
+        Body name -> validity block (:func:`flexible_validity`).
+    """
+    from ..errors import warn
+    from .flexstage import dynamic_stress, flexible_bodies_of, flexible_key
+
+    sel = np.asarray(hist.t) >= t_start
+    t = np.asarray(hist.t)[sel]
+    out = {}
+    for b in flexible_bodies_of(mech):
+        modal = np.asarray(hist.modal[b.name])[sel]
+        stress = dynamic_stress(b, modal, t, np.asarray(hist.crank_angle)[sel])
+        out[b.name], texts = flexible_validity(b, elastic_deflection(b, modal, t), stress,
+                                               flexible_key(b.name))
+        for text in texts:
+            warn(text, into=warnings)
+    return out
