@@ -284,7 +284,7 @@ def api_markdown() -> str:
              "from it at build time; `import crankmodal` is cheap and each name is imported from "
              "its home module on first use). Units are SI (m, kg, s, N, Pa, rad; Hz where a name "
              "says so). `crankmodal.__version__` is the installed version. Worked examples are in "
-             "[Python API by example](../guide/api_examples.md).", ""]
+             "the [Python API](../guide/python_api.md) guide.", ""]
     for title, text, _ in API_GROUPS + [("Other", "", ())]:
         members = groups.get(title, other if title == "Other" else [])
         if not members:
