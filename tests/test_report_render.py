@@ -154,3 +154,26 @@ def test_a_stress_peak_at_an_undrawn_node_is_said_under_the_render():
     assert note is not None and "up to 1;" in note and "25.5" in note
     v[corners[0]] = 25.5  # the maximum on a drawn node too: nothing to say
     assert undrawn_peak_note(v, v[surf.node_ids]) is None
+
+
+def test_a_gif_frame_keeps_the_whole_title_and_colour_bar_label_inside_the_picture(tmp_path,
+                                                                                    bar_modes):
+    """Issue 25 #15 (the crank report's GIFs read 'lode 1: 1192.3 Hz, bending about' and
+    'displacement /'): the title band and the colour bar's label stay clear of the picture's
+    left and right edges."""
+    from PIL import Image
+
+    from crankmodal.report.render import animate_mode
+
+    part, modes = bar_modes
+    surf = boundary_surface(part.mesh.points, part.mesh.cells[0].data)
+    path = animate_mode(surf, modes.shapes[:, 0], tmp_path / "m.gif",
+                        "Mode 1: 1192.3 Hz, bending about y", part_camera(surf.points),
+                        n_frames=2)
+    img = np.asarray(Image.open(path).convert("L"), int)
+    h, w = img.shape
+    band = img[: int(0.2 * h)]  # title and the colour bar's label
+    ink = np.flatnonzero((band < 128).any(axis=0))
+    assert ink.size, "no title drawn"
+    margin = int(0.01 * w)
+    assert ink.min() > margin and ink.max() < w - 1 - margin, (ink.min(), ink.max(), w)

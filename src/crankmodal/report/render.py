@@ -199,25 +199,30 @@ def render_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: d
 
 
 def animate_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: dict,
-                 n_frames: int = 16, window_size=(480, 360),
+                 n_frames: int = 16, window_size=(640, 480),
                  fraction: float = DEFORMATION_FRACTION) -> Path:
-    """Animated GIF of one mode (one period, ``n_frames`` frames), written with Pillow."""
+    """Animated GIF of one mode (one period, ``n_frames`` frames), written with Pillow.
+
+    Each frame is drawn as the still is (:data:`WINDOW_SIZE`, the same title and colour bar
+    fonts) and scaled down to ``window_size``: drawn directly at the small size the title and the
+    colour bar's label ran off the picture."""
     from PIL import Image
 
     u = surface.displacement(shape)
-    pl = _plotter(window_size)
+    pl = _plotter(WINDOW_SIZE)
     frames = []
     try:
         mesh, scale = _add_mode_actors(pl, surface, u, camera, fraction, ghost=True)
-        pl.add_text(title, position="upper_edge", font_size=12, color="black")
+        pl.add_text(title, position="upper_edge", font_size=14, color="black")
         _add_triad(pl)
         _place_camera(pl, camera)
         for k in range(n_frames):
             s = np.sin(2 * np.pi * k / n_frames)
             mesh.points = surface.points + s * scale * u
             pl.render()
-            img = pl.screenshot(None, return_img=True)
-            frames.append(Image.fromarray(np.asarray(img)).convert("P", palette=Image.ADAPTIVE))
+            img = Image.fromarray(np.asarray(pl.screenshot(None, return_img=True)))
+            img = img.resize(tuple(window_size), Image.LANCZOS)
+            frames.append(img.convert("P", palette=Image.ADAPTIVE))
     finally:
         pl.close()
     with atomic_path(path) as tmp:
