@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from crankmodal.cli import main
-from crankmodal.errors import CrankmodalError, SceneError
+from crankmodal.errors import SceneError
 from crankmodal.sweep import load_sweep, run_sweep
 from crankmodal.sweep.axes import parse_axis
 from crankmodal.sweep.driver import FAILED_EXIT, plan_tasks
@@ -242,8 +242,8 @@ def test_interrupt_closes_the_cluster_with_one_line(tmp_path, client, sig, code,
     kept = len(RecordStore(rec).read())
     assert proc.returncode == code, stderr
     lines = [ln for ln in stderr.splitlines() if not ln.startswith("dask: ")]
-    assert lines == [f"crankmodal: {word}: {kept} of 12 points recorded; resume with: "
-                     f"crankmodal sweep {sw} --out {out}"]
+    assert lines == [(f"crankmodal: {word}: {kept} of 12 points recorded; resume with: "
+                      f"crankmodal sweep {sw} --out {out}")]
     assert "Traceback" not in stderr and "leaked" not in stderr and stdout == ""
     assert not (out / "sweep.json").exists() and 2 <= kept < 12
     res = run_sweep(sw, out, client=client, figures=False)
