@@ -173,3 +173,18 @@ def test_fe_crank_torsion_modes_beside_the_forced_chain(tmp_path):
     assert fe["rows"] and all(classes[r["fe_mode"] - 1].startswith("torsion") for r in fe["rows"])
     # the solid-only chain is stiffer-per-inertia than the running one (no reciprocating inertia)
     assert fe["rows"][0]["solid_chain_hz"] > fe["rows"][0]["chain_hz"]
+
+
+def test_orders_left_out_and_a_viscous_damper_are_warned():
+    from crankmodal.scene import scene_from_dict
+
+    def warnings_of(forced):
+        sc = scene_from_dict({"mechanism": {"machine": "inline6_engine"},
+                              "torsion": {"machine": "inline6_engine", "forced": forced}})
+        return check(sc)["torsion"]["forced"]["validity_warnings"]
+
+    w12 = warnings_of({"max_order": 12.0})
+    assert any("order 15 above max_order" in w for w in w12)
+    assert any("viscous damper ring free" in w for w in w12)
+    w18 = warnings_of({"max_order": 18.0, "dampers": []})
+    assert w18 == []

@@ -150,6 +150,34 @@ def _default_name(chain, i):
     return f"{chain.labels[i]} - {chain.labels[i + 1]}"
 
 
+#: largest per-order response kept in memory (speeds x orders x DOF complex numbers, 160 MB)
+MAX_RESPONSE_SIZE = 1.0e7
+#: an order above max_order whose torque exceeds this fraction of the largest is warned
+TRUNCATION_WARNING = 0.05
+
+
+def _validity_warnings(f: dict, excitation, train, machine, ops, eff) -> list[str]:
+    """What the model leaves out that this scene depends on (texts for results.json warnings)."""
+    out = []
+    if machine is not None and eff is not None:
+        n_op = (ops[0] if ops else machine.speed_rpm) * math.pi / 30.0
+        spec = np.abs(np.fft.rfft(eff.torque(n_op).sum(axis=1)))[1:]
+        k_kept = len(excitation.orders)
+        if len(spec) > k_kept and spec[k_kept:].max() > TRUNCATION_WARNING * spec.max():
+            q = (k_kept + 1 + int(np.argmax(spec[k_kept:]))) / excitation.cycle_revolutions
+            out.append(f"torsion.forced: order {q:g} above max_order carries "
+                       f"{100 * spec[k_kept:].max() / spec.max():.1f} % of the largest order's torque "
+                       "on the crank; raise max_order")
+    if any(d.kind == "viscous" for d in train.dampers):
+        out.append("torsion.forced: natural frequencies and margins are those with the viscous damper "
+                   "ring free (zero damping); with the ring locked they are lower -- the forced response "
+                   "includes the damper exactly")
+    if f["modal_damping"] > 0.1:
+        out.append(f"torsion.forced.modal_damping: {f['modal_damping']:g} is far above the 0.01-0.05 of "
+                   "crank trains (resonant amplification 1/(2 zeta) below 5)")
+    return out
+
+
 def validate(tp: dict, scene, chain, model) -> dict:
     """Check ``[torsion.forced]`` and build the train, excitation and stress data.
 
@@ -264,12 +292,20 @@ def validate(tp: dict, scene, chain, model) -> dict:
                 key = f"{KEY}.operating_speeds_rpm[{i}]"
             raise SceneError(f"{key}: the band {a:.5g}..{b:.5g} rpm around {n_op:g} rpm lies outside the "
                              f"speed range {speeds[0]:.5g}..{speeds[-1]:.5g} rpm")
+    size = len(speeds) * len(excitation.orders) * train.n_dofs
+    if size > MAX_RESPONSE_SIZE:
+        raise SceneError(
+            f"{KEY}.speed_step_rpm: {len(speeds)} speeds x {len(excitation.orders)} orders x {train.n_dofs} DOF "
+            f"= {size:.3g} complex amplitudes ({16 * 2 * size / 1e9:.2g} GB with the section torques); at most "
+            f"{MAX_RESPONSE_SIZE:.0e}: raise the step, narrow the range or lower max_order")
+    warnings = _validity_warnings(f, excitation, train, machine, ops, efforts)
     drive = f["drive_section"] or len(chain.stiffnesses)
     if drive > len(chain.stiffnesses):
         raise SceneError(f"{KEY}.drive_section: must be 1..{len(chain.stiffnesses)}, got {drive}")
     f.update(speeds=speeds, excitation=excitation, train=train, machine=machine, arrangement=arrangement,
              efforts=efforts, section_objects=sections, section_names=names, allowable=allowable,
-             operating=list(ops), drive=drive - 1, cycle_revolutions=cr, crank_model=model)
+             operating=list(ops), drive=drive - 1, cycle_revolutions=cr, crank_model=model,
+             validity_warnings=warnings)
     return f
 
 
@@ -344,7 +380,12 @@ def run(f: dict, ctx, chain) -> dict:
         "operating_speeds_rpm": ops,
         "files": files,
         "summary": summary,
+        "warnings": list(f["validity_warnings"]),
     }
+    from ..errors import warn
+
+    for w in f["validity_warnings"]:
+        warn(w)
     modal = ctx.results.get("modal")
     if modal and modal.get("classes"):  # the FE crank of the same scene, mode by mode
         from .fe_beside import fe_beside_train

@@ -252,6 +252,8 @@ def run(p: dict, ctx) -> dict:
 
         res["forced"] = run_forced(p["forced"], ctx, chain)
         res["files"] += res["forced"]["files"]
+        if res["forced"]["warnings"]:
+            res.setdefault("warnings", []).extend(res["forced"]["warnings"])
     beside = beside_cad_and_fe(res, ctx, p["n_throws"])
     if beside:
         res.update(beside)
