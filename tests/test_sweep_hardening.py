@@ -366,3 +366,23 @@ def test_bad_worker_count_from_python_is_one_error_naming_it(tmp_path, workers):
     with pytest.raises(ParameterError, match=r"^workers: must be an integer >= 1, got "):
         run_sweep(sw, tmp_path / "o", workers=workers)
     assert not (tmp_path / "o").exists()
+
+
+def test_search_whose_every_point_failed_exits_4_with_its_table(tmp_path, client, capsys):
+    """It stopped at exit 2 ("search: no point produced a number"), as for bad input, without
+    sweep.json and without saying that every point had failed, nor where."""
+    sw = write_sweep(tmp_path, f"outputs = ['{F1}']\n[axes]\n"
+                     f"{THROW} = {{start = 0.0, stop = 180.0, num = 3}}\n"
+                     f"[search]\nmaximize = '{F1}'\n")
+    spec = load_sweep(sw)
+    for task in plan_tasks(spec, spec.points(), (tmp_path / "o").resolve()):
+        Path(task["dir"]).parent.mkdir(parents=True, exist_ok=True)
+        Path(task["dir"]).write_text("in the way")  # every point fails inside its run
+    rc = main(["--quiet", "sweep", str(sw), "--out", str(tmp_path / "o"), "--scheduler",
+               client.scheduler.address, "--no-figures"])
+    cap = capsys.readouterr()
+    assert rc == 4 and "Traceback" not in cap.err
+    assert "failed: 3 of 3 points (100 %, more than max_failed = 10 %)" in cap.err
+    assert "search: no best" in cap.out
+    summary = json.loads((tmp_path / "o" / "sweep.json").read_text())
+    assert summary["search"]["best_point"] is None and summary["n_failed"] == 3

@@ -153,7 +153,8 @@ def _sweep(args) -> int:
     if "search" in res:
         s = res["search"]
         print(f"search: {s['sense']} {s['objective']} = {s['best_value']!r} at "
-              f"{s['best_parameters']} (point {s['best_point']})")
+              f"{s['best_parameters']} (point {s['best_point']})" if s["best_point"] is not None
+              else f"search: no best {s['objective']}: every point failed")
     print(f"sweep: {out_dir / 'sweep.json'}")
     print(res["failures"]["line"], file=sys.stderr if res["failures"]["exceeded"] else sys.stdout)
     return FAILED_EXIT if res["failures"]["exceeded"] else 0

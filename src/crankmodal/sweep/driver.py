@@ -623,6 +623,10 @@ def _search_result(spec, records, rounds) -> dict:
 
     s = spec.search
     top = best(records, s["objective"], s["sense"])
+    if top is None and all(r["status"] != "ok" for r in records):
+        # every point failed: no best, and the failures line (exit 4) says where the errors are
+        return {"objective": s["objective"], "sense": s["sense"], "best_point": None,
+                "best_parameters": None, "best_value": None, "rounds": rounds}
     if top is None:
         raise CrankmodalError(f"search: no point produced a number for {s['objective']!r}")
     return {"objective": s["objective"], "sense": s["sense"], "best_point": top["point"],
