@@ -44,7 +44,7 @@ CONNECT_TIMEOUT_S = 3
 
 
 #: Exit status of ``crankmodal sweep`` when more than ``max_failed`` of the points failed: the
-#: table and summary are written (unlike exit 2, bad input, where nothing is), but a script
+#: table and summary are written (unlike exit 2, bad input, where neither is), but a script
 #: must not take them for a complete sweep.
 FAILED_EXIT = 4
 
