@@ -274,6 +274,7 @@ def to_jsonable_summary(part) -> dict:
 
 def _study(p, ctx, rep, out, measured) -> None:
     """The mesh-simplification study (``study = true``) as a section of the report."""
+    from .quantity import percent
     from .study_scene import run_simplification
 
     st, paths = run_simplification(ctx.params, ctx.out_dir, figures=ctx.figures,
@@ -285,8 +286,8 @@ def _study(p, ctx, rep, out, measured) -> None:
                   f"Modes are paired with the reference model's by MAC on common surface "
                   f"points († marks a mode paired out of rank order).")
     rep.table(*st.table(measured))
-    rep.paragraph(f"Recommendation (tolerance {100 * st.tolerance:.3g} %): "
-                  f"{st.recommendation_text()}.")
+    rep.paragraph(f"Verdict: the cheapest model whose estimated error is within the tolerance "
+                  f"±{percent(st.tolerance)} (report.tolerance): {st.recommendation_text()}.")
     for key, cap in (("error_vs_time", "Error against run time, Pareto front dashed"),
                      ("convergence", "Frequency against DOF")):
         if key in paths:
