@@ -130,8 +130,8 @@ def test_free_free_modes_leave_out_the_zero_effective_mass_columns_and_say_why()
     assert held.count("m_eff") == 3 and held.count("J_eff") == 3
 
 
-def _captured_figures(monkeypatch, tmp_path) -> dict:
-    """Run the mechanism stage and keep each figure as it is saved (name -> Figure)."""
+def _captured_figures(monkeypatch, tmp_path, sections=("mechanism",)) -> dict:
+    """Run the scene's ``sections`` and keep each figure as it is saved (name -> Figure)."""
     from crankmodal import results
 
     figs = {}
@@ -142,7 +142,7 @@ def _captured_figures(monkeypatch, tmp_path) -> dict:
         return save(fig, path, **kw)
 
     monkeypatch.setattr(results, "savefig_atomic", spy)
-    run(scene_from_dict({"mechanism": SCENE["mechanism"]}, name="m", base_dir=tmp_path),
+    run(scene_from_dict({k: SCENE[k] for k in sections}, name="m", base_dir=tmp_path),
         tmp_path / "out")
     return figs
 
@@ -215,3 +215,13 @@ def test_per_revolution_statistics_carry_units_with_the_spread_in_the_means_pref
         "35.67", "9.018", "5.207"]
     assert rows["clearance joints: big end 1: impact velocity: max per rev"] == [
         "0.6244 m/s", "0.2021 m/s", "0.1167 m/s"]
+
+
+def test_figure_titles_and_axis_labels_print_no_exponent_notation(monkeypatch, tmp_path):
+    """The Holzer residual's axis read 'asinh(residual / 2.77e+04 N m)'."""
+    figs = _captured_figures(monkeypatch, tmp_path, ("mechanism", "torsion"))
+    assert "torsion_holzer_residual.png" in figs
+    for name, fig in figs.items():
+        for ax in fig.axes:
+            for text in (ax.get_title(), ax.get_xlabel(), ax.get_ylabel()):
+                assert not re.search(r"\d[eE][+-]?\d", text), (name, text)

@@ -39,7 +39,9 @@ def plot_holzer_residual(result, path: str | Path) -> Path:
         ax.annotate(f"{fr:.4g} Hz", (fr, 0.0), rotation=90, va="bottom", ha="right", fontsize=8)
     unit = "N m" if result.residual_kind == "torque_Nm" else "rad"
     ax.set_xlabel("trial frequency (Hz)")
-    ax.set_ylabel(f"asinh(residual / {s:.3g} {unit})")
+    from ..report.quantity import quantity  # 27.7 kN m, not 2.77e+04 N m (issue 25 #15)
+
+    ax.set_ylabel(f"asinh(residual / {quantity(s, unit, 3)})")
     ax.set_title("Holzer residual")
     return _save(plt, fig, path)
 
