@@ -225,3 +225,21 @@ def test_figure_titles_and_axis_labels_print_no_exponent_notation(monkeypatch, t
         for ax in fig.axes:
             for text in (ax.get_title(), ax.get_xlabel(), ax.get_ylabel()):
                 assert not re.search(r"\d[eE][+-]?\d", text), (name, text)
+
+
+@pytest.mark.parametrize("reference", [None, [100.0, 210.0]])
+def test_convergence_title_promises_dashed_lines_only_when_they_are_drawn(monkeypatch, tmp_path,
+                                                                         reference):
+    from crankmodal.report import plots
+
+    figs = []
+    save = plots.savefig_atomic
+    monkeypatch.setattr(plots, "savefig_atomic", lambda fig, p, **kw: (figs.append(fig),
+                                                                       save(fig, p, **kw)))
+    runs = [{"fidelity": "full", "order": 2, "n_dofs": n, "mesh_size": h,
+             "frequencies_hz": [100.0 + 1e3 / n, 210.0 + 1e3 / n]}
+            for n, h in ((1000, 0.02), (8000, 0.01))]
+    plots.plot_convergence(runs, tmp_path / "c.png", reference_hz=reference)
+    ax = figs[0].axes[0]
+    dashed = [ln for ln in ax.get_lines() if ln.get_linestyle() == "--"]
+    assert ("dashed" in ax.get_title()) == bool(dashed) == (reference is not None)

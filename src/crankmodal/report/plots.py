@@ -108,7 +108,8 @@ def plot_convergence(runs, path, reference_hz=None, n_modes: int | None = None) 
     runs : list of dict
         ``fidelity``, ``order``, ``n_dofs``, ``frequencies_hz``, ``mesh_size``.
     reference_hz : sequence, optional
-        Drawn as dotted horizontal lines (the extrapolated values).
+        Drawn as dashed horizontal lines (the extrapolated values); the title mentions them
+        only when they are drawn.
     """
     path = Path(path)
     n = n_modes or min(len(r.get("matched_hz", r["frequencies_hz"])) for r in runs)
@@ -134,7 +135,8 @@ def plot_convergence(runs, path, reference_hz=None, n_modes: int | None = None) 
     ax.set_xscale("log")
     ax.set_xlabel("degrees of freedom")
     ax.set_ylabel("natural frequency, Hz")
-    ax.set_title("Frequency against DOF (colour: mode; dashed: extrapolated reference)")
+    ax.set_title("Frequency against DOF (colour: mode"
+                 + ("; dashed: extrapolated reference)" if reference_hz is not None else ")"))
     ax.grid(True, which="both", alpha=0.3)
     from matplotlib.lines import Line2D
 
