@@ -207,8 +207,10 @@ def test_max_failed_from_the_sweep_file_and_its_bad_values(tmp_path, client, cap
 # ---------------------------------------------------------------- Ctrl-C
 
 
-@pytest.mark.parametrize("sig, code, word", [(signal.SIGINT, 130, "interrupted"),
-                                             (signal.SIGTERM, 143, "terminated")])
+@pytest.mark.parametrize("sig, code, word", [
+    (signal.SIGINT, 130, "interrupted"),
+    pytest.param(signal.SIGTERM, 143, "terminated", marks=pytest.mark.slow),  # the same path
+])
 def test_interrupt_closes_the_cluster_with_one_line(tmp_path, client, sig, code, word):
     """SIGINT to the CLI's whole process group, as a terminal's Ctrl-C sends it (to the Dask
     workers too), or SIGTERM to the CLI: one line, the status of a shell, no traceback from any
