@@ -359,6 +359,20 @@ def test_check_refuses_a_bar_too_fine_or_too_small(assignment, key, tmp_path):
     one_error_line(status, stderr, key)
 
 
+@pytest.mark.parametrize("assignment, fragment", [
+    ("dynamics.flexible.crank.mesh_size=1e-300", "dynamics.flexible.crank.mesh_size: must be in "
+                                                 "[1e-06, 100] m"),
+    ("dynamics.flexible.crank.mesh_size=1e-4", "dynamics.flexible.crank.mesh_size = 0.0001 m: at "
+                                               "least 1.8e+09 tetrahedra"),
+])
+def test_check_refuses_a_machine_part_reduced_here_too_fine(assignment, fragment):
+    """The part a [dynamics.flexible] crank or rod reduces is checked by `check` (it passed, and
+    `run` refused it only after the [mechanism] stage), under the table's own key."""
+    status, stderr = run_in_process("check", SCENES / "seed000_flexible_crank.toml", "--set",
+                                    assignment)
+    one_error_line(status, stderr, fragment)
+
+
 @pytest.mark.parametrize("assignment", ["dynamics.flexible.coupler.mesh_size=1e-6",
                                         "dynamics.flexible.coupler.bar=[1e-300, 0.077]"])
 def test_run_refuses_a_bar_too_fine_or_too_small(assignment, tmp_path):

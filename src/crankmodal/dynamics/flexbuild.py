@@ -84,6 +84,36 @@ def crank_interface_specs(regions, rods_per_pin: int) -> list[dict]:
     return specs
 
 
+def check_part(machine: str, part: str, spec: dict) -> tuple[dict, dict]:
+    """The validated ``[geometry]`` and ``[material]`` parameters of the part
+    :func:`reduced_part` makes, checked before anything is built (the part's lengths, the
+    element count of ``mesh_size``, the material); a ``crankmodal check`` refuses what a run
+    would. Errors name the ``[dynamics.flexible]`` table's keys
+    (``dynamics.flexible.crank.mesh_size``).
+
+    Raises
+    ------
+    SceneError
+    """
+    from types import SimpleNamespace
+
+    from ..fem.material_stage import validate as validate_material
+    from ..geometry.stage import validate as validate_geometry
+
+    where = f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
+    raw = {"machine": machine, "part": part, "fidelity": spec["fidelity"],
+           "mesh_size": spec["mesh_size"], "element_order": spec["element_order"]}
+    try:
+        gp = validate_geometry(raw, SimpleNamespace(sections={"reduction": {}}))
+        mp = validate_material({"name": spec["material"]}, None)
+    except SceneError as exc:
+        text = str(exc)
+        for key in ("mesh_size", "element_order", "fidelity"):  # this table's own keys
+            text = text.replace(f"geometry.{key}", f"{where}.{key}")
+        raise SceneError(text if text.startswith(where) else f"{where}: {text}") from None
+    return gp, mp
+
+
 def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
     """The ``crankmodal-flexbody`` file of a machine's part, reduced once and cached.
 
@@ -99,27 +129,17 @@ def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
         Rods on the crank (crankshaft only): each crankpin region is cut into
         ``ceil(n_rods / crankpin regions)`` bands, one interface each.
     """
-    from types import SimpleNamespace
-
     from ..fem.assembly import assemble
     from ..fem.material_stage import make_material
-    from ..fem.material_stage import validate as validate_material
     from ..geometry.cache import part_key
     from ..geometry.stage import make_part
-    from ..geometry.stage import validate as validate_geometry
     from ..reduction.interfaces import make_interfaces
     from ..reduction.io import save_flexbody
     from ..reduction.reduce import reduce_body
     from ..reduction.stage import interface_specs
 
     where = f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
-    raw = {"machine": machine, "part": part, "fidelity": spec["fidelity"],
-           "mesh_size": spec["mesh_size"], "element_order": spec["element_order"]}
-    try:
-        gp = validate_geometry(raw, SimpleNamespace(sections={"reduction": {}}))
-        mp = validate_material({"name": spec["material"]}, None)
-    except SceneError as exc:
-        raise SceneError(f"{where}: {exc}") from None
+    gp, mp = check_part(machine, part, spec)
     desc = {"part": part, "params": gp["part_params"].to_dict(), "fidelity": gp["fidelity"],
             "mesh": {"size": spec["mesh_size"], "order": spec["element_order"]}}
     key_text = json.dumps({"part": part_key(desc), "material": spec["material"],
@@ -527,6 +547,6 @@ def rigid_twin(body):
     return RigidBody(body.name, body.mass, body.j0 + body.attached_inertia, frames, z=body.z)
 
 
-__all__ = ["cached_flexbody", "check_bar", "crank_body", "crank_interface_specs",
+__all__ = ["cached_flexbody", "check_bar", "check_part", "crank_body", "crank_interface_specs",
            "flexbody_cache_dir", "link_body", "read",
            "reduced_bar", "reduced_part", "rigid_twin", "rod_body"]

@@ -287,6 +287,13 @@ def validate_section(raw: dict) -> dict:
             spec = p["flexible"].get(role)
             if spec is not None and spec["bar"] is not None:
                 check_bar(float(length), spec["bar"], spec, f"dynamics.flexible.{role}")
+    elif isinstance(p.get("machine"), str):  # a machine's part reduced here: checked likewise
+        from .flexbuild import check_part
+
+        for key, part in (("crank", "crankshaft"), ("rods", "rod")):
+            spec = p["flexible"].get(key)
+            if spec is not None and spec["file"] is None:
+                check_part(p["machine"], part, spec)
     return p
 
 
