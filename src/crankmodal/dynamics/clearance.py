@@ -12,9 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from . import laws
-from .lubrication import short_bearing_film
+from .lubrication import film_arguments, short_film
 
 FILM_MODELS = ("short", "finite")
 
@@ -127,14 +128,8 @@ class ClearanceJoint:
         """
         if self.clearance_major is None:
             return self.clearance, 0.0
-        a = self.journal_radius + self.clearance_major
-        b = self.journal_radius + self.clearance
-        ph = phi - self.wear_angle
-        cs, sn = np.cos(ph), np.sin(ph)
-        s2 = (b * cs) ** 2 + (a * sn) ** 2
-        rho = a * b / np.sqrt(s2)
-        drho = -a * b * (a * a - b * b) * sn * cs / s2**1.5
-        return float(rho - self.journal_radius), float(drho)
+        return worn_bore_clearance(float(phi), float(self.journal_radius), float(self.clearance),
+                                   float(self.clearance_major), float(self.wear_angle))
 
     def __post_init__(self):
         if self.film_model not in FILM_MODELS:
@@ -153,20 +148,15 @@ class ClearanceJoint:
     def film_force(self, k) -> np.ndarray:
         """Film force on the journal (global x, y), N (``film_model``: short or finite)."""
         c = self.clearance
-        d = k["d"]
-        eps = min(d / c, self.eps_max)
         n, t = k["n"], k["t"]
-        # wedge eps (omega - 2 gamma_dot) with eps gamma_dot = (t . vrel) / c: no 1/|e|, so the
-        # force stays smooth through the bearing centre (gamma_dot alone is singular there);
-        # beyond eps_max the film is frozen at eps_max, as is its whirl term
-        whirl = float(t @ k["vrel"]) / c * (eps * c / d if d > self.eps_max * c else 1.0)
-        wedge = eps * k["omega_sum"] - 2.0 * whirl
+        eps, wedge, eps_dot = film_arguments(k["d"], float(n @ k["vrel"]), float(t @ k["vrel"]),
+                                             k["omega_sum"], c, self.eps_max)
         if self.film_model == "finite":
             from .reynolds import finite_bearing_film as law
         else:
-            law = short_bearing_film
-        fr, ftan = law(eps, wedge, float(n @ k["vrel"]) / c, self.viscosity,
-                       self.journal_radius, self.bearing_length, c)
+            law = short_film
+        fr, ftan = law(eps, wedge, eps_dot, self.viscosity, self.journal_radius,
+                       self.bearing_length, c)
         return float(fr) * n + float(ftan) * t
 
     def gap(self, sysm, q) -> float:
@@ -211,3 +201,35 @@ class ClearanceJoint:
                  p_damp=(fn - fel) * ddot - p_film, p_fric=-ft * k["v_slip"],
                  v_elastic=float(self.normal.elastic_energy(delta)))
         return k
+
+
+@njit(cache=True)
+def worn_bore_clearance(phi, journal_radius, clearance, clearance_major, wear_angle):
+    """Radial clearance of a worn (elliptical) bore in direction ``phi`` and its derivative.
+
+    The bore is an ellipse of semi-axes ``a = r + c_major`` along ``wear_angle`` and
+    ``b = r + c`` (``r`` the journal radius); its polar radius from the centre is
+    ``rho = a b / sqrt((b cos u)^2 + (a sin u)^2)``, ``u = phi - wear_angle``.
+
+    Parameters
+    ----------
+    phi : float
+        Direction from the bore centre, rad, in the bearing body's frame.
+    journal_radius, clearance, clearance_major : float
+        ``r``, the minor- and the major-axis radial clearance, m.
+    wear_angle : float
+        Direction of the major axis in the bearing body's frame, rad.
+
+    Returns
+    -------
+    c, dc_dphi : float
+        ``rho - r``, m, and ``d rho / d phi``, m/rad.
+    """
+    a = journal_radius + clearance_major
+    b = journal_radius + clearance
+    ph = phi - wear_angle
+    cs, sn = np.cos(ph), np.sin(ph)
+    s2 = (b * cs) ** 2 + (a * sn) ** 2
+    rho = a * b / np.sqrt(s2)
+    drho = -a * b * (a * a - b * b) * sn * cs / s2**1.5
+    return rho - journal_radius, drho

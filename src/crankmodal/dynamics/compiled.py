@@ -1,8 +1,9 @@
 """The right-hand side of a planar multibody system compiled with Numba.
 
 For a system of rigid and planar flexible (floating-frame, modal) bodies joined by pins, sliders
-and angle drives, with round dry clearance joints (any law of :mod:`.laws`), piston loads (gas
-force and ring friction) and crank torques, :class:`CompiledSystem` evaluates what
+and angle drives, with clearance joints (round or worn elliptical bores, dry or with the
+short-bearing oil film; any law of :mod:`.laws`), piston loads (gas force and ring friction) and
+crank torques, :class:`CompiledSystem` evaluates what
 :meth:`Multibody.solve` and :meth:`Multibody.rhs` evaluate in two Numba-compiled calls
 (``cache=True``: compiled once per machine, ~20 s, then loaded in ~1 s) around LAPACK's solve:
 :func:`assemble` (frame table, flexible-body terms, applied and contact forces, constraint terms
@@ -15,7 +16,13 @@ joint) to ~1 ms (flexible) per evaluation in some hundred small NumPy calls; thi
 
 The formulas are those of :mod:`.system`, :mod:`.fastpath`, :mod:`.flexible`, :mod:`.clearance`,
 :mod:`.contact` and :mod:`.loads`, written out per scalar; the results agree to round-off (the
-tests compare both paths state by state). The system is read once, when the compiled form is
+tests compare both paths state by state). The worn bore's clearance
+(:func:`.clearance.worn_bore_clearance`) and the short-bearing film
+(:func:`.lubrication.film_arguments`, :func:`.lubrication.short_film`) are not copied: they are
+Numba functions that the Python path calls too. Numba's cache does not see a change in a
+function of another module that a cached function calls (numba issue #1833): after editing those
+two modules, delete this module's cache (``__pycache__/compiled*.nb*``) or set
+``NUMBA_CACHE_DIR`` to a fresh directory; a stale kernel fails the state-by-state tests. The system is read once, when the compiled form is
 built: changing a joint's parameters afterwards is not seen. The impact velocities of
 restitution laws are the integrator's state, passed at every call.
 """
@@ -27,16 +34,22 @@ from numba import njit
 from scipy.linalg.lapack import dgesv as _gesv
 
 from .bodies import Ground, RigidBody
-from .clearance import ClearanceJoint
+from .clearance import ClearanceJoint, worn_bore_clearance
 from .fastpath import frames_of
 from .flexible import FlexibleBody
 from .joints import AngleDrive, Prismatic, Revolute
 from .loads import CrankTorque, PistonLoads
+from .lubrication import film_arguments, short_film
 
 #: per clearance joint diagnostics written by the kernel (columns of ``diag``)
 DIAG = ("ex", "ey", "nx", "ny", "d", "delta", "delta_dot", "v_slip", "fn", "ft", "fx", "fy",
-        "v_elastic", "p_damp", "p_fric", "fel", "vrx", "vry", "omega_sum")
+        "v_elastic", "p_damp", "p_fric", "fel", "vrx", "vry", "omega_sum", "gx", "gy", "dtheta",
+        "r_b", "film")
 _D = {k: i for i, k in enumerate(DIAG)}
+#: columns of the clearance joints' float table: clearance (minor for a worn bore), journal
+#: radius, v_impact_min, clearance_major (-1: round bore), wear_angle, viscosity (film flag in
+#: the integer table), bearing_length, eps_max
+N_CL_F = 8
 _S_CAP = 3.0
 _BODIES = (RigidBody, FlexibleBody)
 #: the powers the kernel integrates: system.AUX_NAMES (drive, loads, ideal joints, contact
@@ -45,14 +58,21 @@ N_AUX = 6
 
 
 def applicable(sysm) -> bool:
-    """True when every part of ``sysm`` has a compiled form (see the module docstring)."""
+    """True when every part of ``sysm`` has a compiled form (see the module docstring).
+
+    Clearance joints: round and worn (elliptical) bores, dry or with the short-bearing film
+    (``film_model = "short"``). A finite-length film (``film_model = "finite"``: the Reynolds
+    table of :mod:`.reynolds`, SciPy splines looked up per call) has no compiled form yet, so
+    a system with one runs on the Python path.
+    """
     if not all(type(b) in _BODIES for b in sysm.bodies):
         return False
     if not all(type(c) in (Revolute, Prismatic, AngleDrive) for c in sysm.constraints):
         return False
     for cj in sysm.clearances:
-        if type(cj) is not ClearanceJoint or cj.clearance_major is not None \
-                or cj.viscosity is not None:
+        if type(cj) is not ClearanceJoint:
+            return False
+        if cj.viscosity is not None and cj.film_model != "short":
             return False
         if not all(isinstance(b, (*_BODIES, Ground)) for b in (cj.journal, cj.bearing)):
             return False
@@ -259,7 +279,10 @@ def _add_force(Q2, fr, arm, k, fx, fy, mz):
 
 @njit(cache=True)
 def _clearance(j, pose, vel, cl_int, cl_f, out):
-    """Kinematics of clearance joint ``j`` into ``out`` (a row of ``diag``)."""
+    """Kinematics of clearance joint ``j`` into ``out`` (a row of ``diag``), as
+    :meth:`.ClearanceJoint.kinematics`: a worn bore's clearance ``c(phi)`` in the direction of
+    the eccentricity (bearing frame) turns the penetration's gradient off the normal,
+    ``grad = n - (c' / d) t``, and adds ``c' omega_bearing`` to its rate."""
     kj, kb = cl_int[j, 0], cl_int[j, 1]
     ex = pose[kj, 0] - pose[kb, 0]
     ey = pose[kj, 1] - pose[kb, 1]
@@ -270,13 +293,22 @@ def _clearance(j, pose, vel, cl_int, cl_f, out):
         nx, ny = 1.0, 0.0
     vrx = vel[kj, 0] - vel[kb, 0]
     vry = vel[kj, 1] - vel[kb, 1]
-    c, rj = cl_f[j, 0], cl_f[j, 1]
+    c, rj, c_major = cl_f[j, 0], cl_f[j, 1], cl_f[j, 3]
+    dc = 0.0
+    if c_major >= 0.0:  # worn bore (a round one has c_major = -1)
+        c, dc = worn_bore_clearance(np.arctan2(ny, nx) - pose[kb, 2], rj, c, c_major,
+                                    cl_f[j, 4])
+    gx, gy = nx, ny
+    if dc != 0.0 and d > 1e-300:
+        gx = nx + (dc / d) * ny
+        gy = ny - (dc / d) * nx
     out[0], out[1], out[2], out[3], out[4] = ex, ey, nx, ny, d
     out[5] = d - c
-    out[6] = nx * vrx + ny * vry
+    out[6] = gx * vrx + gy * vry + dc * vel[kb, 2]
     out[7] = -ny * vrx + nx * vry + rj * vel[kj, 2] - (rj + c) * vel[kb, 2]
     out[16], out[17] = vrx, vry
     out[18] = vel[kj, 2] + vel[kb, 2]
+    out[19], out[20], out[21], out[22] = gx, gy, dc, rj + c
 
 
 @njit(cache=True)
@@ -365,14 +397,14 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
     rev_rows, rev_a, rev_b = _seg(I, io, 4), _seg(I, io, 5), _seg(I, io, 6)
     pri_rows, pri_k = _seg(I, io, 7), _seg(I, io, 8)
     drive_rows, drive_k = _seg(I, io, 9), _seg(I, io, 10)
-    cl_int, pl_int = _seg(I, io, 11).reshape((-1, 4)), _seg(I, io, 12).reshape((-1, 3))
+    cl_int, pl_int = _seg(I, io, 11).reshape((-1, 5)), _seg(I, io, 12).reshape((-1, 3))
     gas_off, tq_k = _seg(I, io, 13), _seg(I, io, 14)
     col_ptr, col_rows, massless = _seg(I, io, 16), _seg(I, io, 17), _seg(I, io, 18)
     fb_int, full = _seg(I, io, 19).reshape((-1, 3)), _seg(I, io, 20)[0]
     mdiag, Q0 = _seg(F, fo, 2), _seg(F, fo, 3)
     pri_n, pri_o = _seg(F, fo, 4).reshape((-1, 2)), _seg(F, fo, 5).reshape((-1, 2))
     pri_ang = _seg(F, fo, 6)
-    cl_f, law_vec = _seg(F, fo, 7).reshape((-1, 3)), _seg(F, fo, 8).reshape((-1, 5))
+    cl_f, law_vec = _seg(F, fo, 7).reshape((-1, N_CL_F)), _seg(F, fo, 8).reshape((-1, 5))
     fric_vec, pl_f = _seg(F, fo, 9).reshape((-1, 4)), _seg(F, fo, 10).reshape((-1, 6))
     gas_x, gas_f, gas_period = _seg(F, fo, 11), _seg(F, fo, 12), _seg(F, fo, 13)
     tq_val, baumgarte, fb_f = _seg(F, fo, 14), F[fo[15]], _seg(F, fo, 16)
@@ -386,7 +418,8 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
     Q2 = Q.reshape((1, n))
     A[:, :] = 0.0
     powers[5] = _flexible(q, qd, fb_int, fb_f, Q, A)
-    # clearance joints (clearance.ClearanceJoint.forces, round dry bore)
+    # clearance joints (clearance.ClearanceJoint.forces: round or worn bore, dry or with the
+    # short-bearing film)
     p_damp = 0.0
     p_fric = 0.0
     for j in range(cl_int.shape[0]):
@@ -401,15 +434,30 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
             mu = friction_coefficient(cl_int[j, 3], fric_vec[j], row[7])
         ft = -mu * fn
         nx, ny = row[2], row[3]
-        fx = -fn * nx + ft * -ny
-        fy = -fn * ny + ft * nx
-        if fn != 0.0:
-            rj, c = cl_f[j, 1], cl_f[j, 0]
+        fx = -fn * row[19] + ft * -ny
+        fy = -fn * row[20] + ft * nx
+        p_film = 0.0
+        row[23] = 0.0
+        if cl_int[j, 4]:  # short-bearing film on the minor clearance
+            vrx, vry = row[16], row[17]
+            eps, wedge, eps_dot = film_arguments(row[4], nx * vrx + ny * vry,
+                                                 -ny * vrx + nx * vry, row[18], cl_f[j, 0],
+                                                 cl_f[j, 7])
+            f_r, f_t = short_film(eps, wedge, eps_dot, cl_f[j, 5], cl_f[j, 1], cl_f[j, 6],
+                                  cl_f[j, 0])
+            ffx = f_r * nx + f_t * -ny
+            ffy = f_r * ny + f_t * nx
+            p_film = ffx * vrx + ffy * vry
+            fx += ffx
+            fy += ffy
+            row[23] = np.hypot(ffx, ffy)
+        if fn != 0.0 or p_film != 0.0:
+            rj = cl_f[j, 1]
             _add_force(Q2, fr, arm, cl_int[j, 0], fx, fy, rj * ft)
-            _add_force(Q2, fr, arm, cl_int[j, 1], -fx, -fy, -(rj + c) * ft)
+            _add_force(Q2, fr, arm, cl_int[j, 1], -fx, -fy, -row[22] * ft - fn * row[21])
         row[8], row[9], row[10], row[11] = fn, ft, fx, fy
         row[12] = elastic_energy(code, law_vec[j], delta) if delta > 0.0 else 0.0
-        row[13] = (fn - fel) * ddot
+        row[13] = (fn - fel) * ddot - p_film
         row[14] = -ft * row[7]
         row[15] = fel
         p_damp += row[13]
@@ -559,7 +607,7 @@ def finish(sol, Q, Cq, cqd, I, io, F, fo, qdd, lam, powers):
 def clearance_kinematics(j, q, qd, I, io, F, fo, out):
     """Penetration (``out[5]``) and its rate (``out[6]``) of clearance joint ``j`` only."""
     fr = _frame_tables(I, io, F, fo)
-    cl_int, cl_f = _seg(I, io, 11).reshape((-1, 4)), _seg(F, fo, 7).reshape((-1, 3))
+    cl_int, cl_f = _seg(I, io, 11).reshape((-1, 5)), _seg(F, fo, 7).reshape((-1, N_CL_F))
     K = fr[0].size
     pose = np.empty((K, 3))
     arm = np.empty((K, 2))
@@ -626,9 +674,12 @@ class CompiledSystem:
                 self.drives.append((r0, ks[0], c.profile))
         cl_int, cl_f, law_vec, fric_vec = [], [], [], []
         for cj in sysm.clearances:
+            film = cj.viscosity is not None
             cl_int.append((key(cj.journal, cj.journal_frame), key(cj.bearing, cj.bearing_frame),
-                           cj.normal.code, cj.friction_law.code))
-            cl_f.append((cj.clearance, cj.journal_radius, cj.v_impact_min))
+                           cj.normal.code, cj.friction_law.code, int(film)))
+            major = -1.0 if cj.clearance_major is None else cj.clearance_major
+            cl_f.append((cj.clearance, cj.journal_radius, cj.v_impact_min, major, cj.wear_angle,
+                         cj.viscosity if film else 0.0, cj.bearing_length, cj.eps_max))
             law_vec.append(cj.normal.vector())
             fric_vec.append(cj.friction_law.vector())
         pl_int, pl_f, gx, gf, off, period = [], [], [], [], [0], []
@@ -712,7 +763,7 @@ class CompiledSystem:
         self._kin = np.zeros(len(DIAG))
         self._zeros = np.zeros(n)
         # for solve's per-joint diagnostics
-        self._cl_frames = [(int(a[0]), int(a[1])) for a in np.reshape(cl_int, (-1, 4))]
+        self._cl_frames = [(int(a[0]), int(a[1])) for a in np.reshape(cl_int, (-1, 5))]
         self._scratch = (np.empty(m), np.empty(m), np.empty((m, n)), np.zeros(N_AUX))
         size = n + m if full else len(massless) + m
         self._size = size  # of the linear system: n + m with a flexible body
@@ -769,19 +820,20 @@ class CompiledSystem:
         for r, _, prof in self.drives:
             nu[r] = prof.speed(t)
         contacts = []
-        for j, cj in enumerate(self.clearances):
+        for j in range(len(self.clearances)):
             row = diag[j]
             nx, ny = row[_D["nx"]], row[_D["ny"]]
             kj, kb = self._cl_frames[j]
             contacts.append({
                 "e": row[0:2].copy(), "n": np.array([nx, ny]), "t": np.array([-ny, nx]),
-                "grad": np.array([nx, ny]), "dtheta": 0.0, "delta": float(row[_D["delta"]]),
+                "grad": np.array([row[_D["gx"]], row[_D["gy"]]]),
+                "dtheta": float(row[_D["dtheta"]]), "delta": float(row[_D["delta"]]),
                 "delta_dot": float(row[_D["delta_dot"]]), "v_slip": float(row[_D["v_slip"]]),
                 "Jj": self._jac(kj, q), "Jb": self._jac(kb, q),
-                "r_b": cj.journal_radius + cj.clearance, "d": float(row[_D["d"]]),
+                "r_b": float(row[_D["r_b"]]), "d": float(row[_D["d"]]),
                 "vrel": row[16:18].copy(), "omega_sum": float(row[_D["omega_sum"]]),
                 "fn": float(row[_D["fn"]]), "ft": float(row[_D["ft"]]), "force": row[10:12].copy(),
-                "film": 0.0, "p_damp": float(row[_D["p_damp"]]),
+                "film": float(row[_D["film"]]), "p_damp": float(row[_D["p_damp"]]),
                 "p_fric": float(row[_D["p_fric"]]), "v_elastic": float(row[_D["v_elastic"]])})
         return {"qdd": qdd, "lam": lam, "phi": phi, "Cq": Cq, "nu": nu, "contacts": contacts,
                 "p_loads": float(powers[1])}

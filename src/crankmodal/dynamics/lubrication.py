@@ -36,8 +36,10 @@ alone is not.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 
+@njit(cache=True)
 def _primitives(eps, theta):
     """Antiderivatives of sin cos / H^3, sin^2 / H^3, cos^2 / H^3 at ``theta`` (continuous)."""
     s = 1.0 - eps * eps
@@ -51,6 +53,63 @@ def _primitives(eps, theta):
     i_ss = (0.5 * psi - 0.5 * sp * cp) / s**1.5
     i_cc = (0.5 * psi + 0.5 * sp * cp + 2.0 * eps * sp + eps * eps * psi) / s**2.5
     return i_sc, i_ss, i_cc
+
+
+@njit(cache=True)
+def short_film(eps, wedge, eps_dot, viscosity, radius, length, clearance):
+    """:func:`short_bearing_film` for scalars (the one implementation of the formula).
+
+    Compiled (Numba), so that the right-hand side kernel of :mod:`.compiled` calls this very
+    function; arguments and returns as :func:`short_bearing_film`, floats, N.
+    """
+    a = wedge
+    b = -2.0 * eps_dot
+    theta0 = np.pi - np.arctan2(b, a)           # the film: where G <= 0, i.e. p >= 0
+    lo_sc, lo_ss, lo_cc = _primitives(eps, theta0)
+    hi_sc, hi_ss, hi_cc = _primitives(eps, theta0 + np.pi)
+    i_sc, i_ss, i_cc = hi_sc - lo_sc, hi_ss - lo_ss, hi_cc - lo_cc
+    k = viscosity * radius * length**3 / (2.0 * clearance**2)
+    return k * (a * i_sc + b * i_cc), k * (a * i_ss + b * i_sc)
+
+
+@njit(cache=True)
+def _short_film_many(eps, wedge, eps_dot, viscosity, radius, length, clearance, f_r, f_t):
+    for i in range(eps.size):
+        f_r[i], f_t[i] = short_film(eps[i], wedge[i], eps_dot[i], viscosity, radius, length,
+                                    clearance)
+
+
+@njit(cache=True)
+def film_arguments(d, v_normal, v_tangential, omega_sum, clearance, eps_max):
+    """The film's arguments ``(eps, wedge, eps_dot)`` from a joint's kinematics.
+
+    Parameters
+    ----------
+    d : float
+        Eccentricity ``|e|``, m.
+    v_normal, v_tangential : float
+        Journal velocity relative to the bearing along ``e / |e|`` and at +90 deg from it, m/s.
+    omega_sum : float
+        Journal's plus bearing's angular velocity, rad/s.
+    clearance : float
+        Radial clearance ``c``, m.
+    eps_max : float
+        Eccentricity ratio at which the film is frozen.
+
+    Returns
+    -------
+    eps, wedge, eps_dot : float
+        ``min(d / c, eps_max)``; ``eps (omega - 2 gamma_dot)``, 1/s; ``v_normal / c``, 1/s.
+
+    Notes
+    -----
+    The wedge is written with ``eps gamma_dot = v_tangential / c``: no ``1 / |e|``, so it stays
+    smooth through the bearing centre (``gamma_dot`` alone is singular there); beyond
+    ``eps_max`` the film is frozen at ``eps_max``, as is its whirl term.
+    """
+    eps = min(d / clearance, eps_max)
+    whirl = v_tangential / clearance * (eps * clearance / d if d > eps_max * clearance else 1.0)
+    return eps, eps * omega_sum - 2.0 * whirl, v_normal / clearance
 
 
 def short_bearing_film(eps, wedge, eps_dot, viscosity, radius, length, clearance):
@@ -73,17 +132,14 @@ def short_bearing_film(eps, wedge, eps_dot, viscosity, radius, length, clearance
     Returns
     -------
     f_r, f_t : ndarray
-        Force along the eccentricity and at +90 deg from it, N.
+        Force along the eccentricity and at +90 deg from it, N (the broadcast shape of the
+        array arguments); :func:`short_film` element by element.
     """
-    eps = np.asarray(eps, float)
-    a = np.asarray(wedge, float)
-    b = -2.0 * np.asarray(eps_dot, float)
-    theta0 = np.pi - np.arctan2(b, a)           # the film: where G <= 0, i.e. p >= 0
-    lo = _primitives(eps, theta0)
-    hi = _primitives(eps, theta0 + np.pi)
-    i_sc, i_ss, i_cc = (h - l for h, l in zip(hi, lo))
-    k = viscosity * radius * length**3 / (2.0 * clearance**2)
-    return k * (a * i_sc + b * i_cc), k * (a * i_ss + b * i_sc)
+    e, w, ed = np.broadcast_arrays(*(np.asarray(x, float) for x in (eps, wedge, eps_dot)))
+    f_r, f_t = np.empty(e.shape), np.empty(e.shape)
+    _short_film_many(np.ravel(e), np.ravel(w), np.ravel(ed), float(viscosity), float(radius),
+                     float(length), float(clearance), f_r.reshape(-1), f_t.reshape(-1))
+    return f_r, f_t
 
 
 def short_bearing_force(eps, eps_dot, gamma_dot, omega, viscosity, radius, length, clearance):

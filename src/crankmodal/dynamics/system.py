@@ -46,7 +46,8 @@ class Multibody:
     compiled : bool
         Evaluate :meth:`solve` and :meth:`rhs` with the Numba-compiled kernel of
         :mod:`.compiled` when every part of the system has a compiled form (all-rigid bodies,
-        pins, sliders, drives, round dry clearance joints, piston loads, crank torques); the
+        pins, sliders, drives, clearance joints without a finite-length film, piston loads,
+        crank torques); the
         generic Python path otherwise. The system must not be changed after its first
         evaluation on the compiled path.
     """
