@@ -324,6 +324,22 @@ def load_flexible_body(path, name: str, **kwargs) -> FlexibleBody:
     """Read a ``crankmodal-flexbody`` .npz as a planar :class:`FlexibleBody`
     (:func:`planar_body`'s keywords).
 
+    Parameters
+    ----------
+    path : str or Path
+        The ``.npz`` the ``[reduction]`` stage or :func:`crankmodal.save_flexbody` wrote.
+    name : str
+        The body's name in the mechanism.
+    **kwargs
+        :func:`planar_body`'s keywords: ``n_modes`` or ``cutoff_hz`` (Hz), ``damping_ratio``,
+        ``interfaces``, ``z`` (m), ``tilt``, ``orientation`` (rad).
+
+    Returns
+    -------
+    FlexibleBody
+        The in-plane floating-frame body (mean axes at the centre of mass), frames named after
+        the file's interfaces.
+
     Raises
     ------
     InputFileError

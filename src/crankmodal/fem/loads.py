@@ -180,6 +180,22 @@ def remote_force(points, cells, facets, force, point=None, moment=None) -> np.nd
     The RBE3-type coupling spreads them with area weights w_a: f_a = w_a (F/W + (J⁻¹ M_c) × r_a),
     r_a from the weighted centroid c, J = Σ w_a (``|r_a|²`` I − r_a r_aᵀ), M_c the moment about c.
     The nodal forces sum to F and their moment about c is M_c, and the region is not stiffened.
+
+    Parameters
+    ----------
+    points, cells, facets
+        As :func:`pressure_load`.
+    force : array_like, shape (3,)
+        The force, N.
+    point : array_like, shape (3,), optional
+        Where it acts, m (default: the region's weighted centroid).
+    moment : array_like, shape (3,), optional
+        A moment about ``point``, N m.
+
+    Returns
+    -------
+    ndarray, shape (3 n,)
+        Nodal forces, N, interleaved x, y, z.
     """
     nodes, w = nodal_areas(points, cells, facets)
     u, inv = np.unique(nodes.ravel(), return_inverse=True)

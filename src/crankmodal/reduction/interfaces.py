@@ -141,6 +141,21 @@ def make_interfaces(part, specs, cells: np.ndarray | None = None) -> list[Interf
     Nodes on a boundary line shared by two regions (adjacent bands of a crankpin) belong to the
     first interface listed; a distributing surface still integrates over all its facets.
 
+    Parameters
+    ----------
+    part : Part
+        The meshed part whose named regions the interfaces tie.
+    specs : list of dict
+        One ``{"region": name, "kind": "rigid" | "distributing"}`` per interface (``kind``
+        defaults to ``rigid``: RBE2-like; ``distributing``: RBE3-like, no stiffness added).
+    cells : ndarray, optional
+        The volume cells (default: the part mesh's first cell block).
+
+    Returns
+    -------
+    list of Interface
+        One 6-DOF interface node each, at the exact bore-axis centre of its region.
+
     Raises
     ------
     ParameterError
