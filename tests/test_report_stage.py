@@ -226,3 +226,29 @@ def test_modal_report_text_has_no_exponent_notation_and_no_escaped_bars(bar_repo
     text = htmlmod.unescape(re.sub(r"<[^>]+>", " ", page))
     assert not re.findall(r"\S*\d[eE][+-]?\d+\S*", text)
     assert "\\|" not in text
+
+
+def test_participation_legend_lists_only_directions_a_mode_moves(bar_report, tmp_path,
+                                                                 monkeypatch):
+    """The cantilever's first modes bend (y, z): their axial (x) effective mass is round-off,
+    so x gets neither bars nor a flat cumulative line in the legend, and the note names it."""
+    from crankmodal.report import plots
+
+    out, _ = bar_report
+    rows = [r.split(",") for r in (out / "participation.csv").read_text().splitlines()[1:]]
+    f = [float(r[1]) for r in rows]
+    frac = np.array([[float(v) for v in r[2:5]] for r in rows])
+    assert frac[:, 0].max() < 1e-4 * frac.max()  # bending: no axial mass (FE: 6e-6 of 0.61)
+    figs = []
+    save = plots.savefig_atomic
+    monkeypatch.setattr(plots, "savefig_atomic", lambda fig, p, **kw: (figs.append(fig),
+                                                                       save(fig, p, **kw)))
+    plots.plot_participation(f, np.hstack([frac, np.zeros((len(f), 3))]), 1.0,
+                             tmp_path / "p.png")
+    ax = figs[0].axes[0]
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert not [t for t in legend if t.startswith("x ")]
+    assert "not drawn: x translation (zero)" in [t.get_text() for t in ax.texts]
+    for name in "yz":
+        if frac[:, "xyz".index(name)].max() > 1e-3 * frac.max():
+            assert f"{name} translation" in legend and f"{name} cumulative" in legend

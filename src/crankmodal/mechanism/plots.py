@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..plotting import COINCIDE_FRACTION, hidden_note, visible_curves
 from ..plotting import pyplot as _pyplot
 
 
@@ -22,52 +23,6 @@ def _deg(res):
 def _labels(res):
     return [f"cyl {i + 1} ({np.degrees(c.bank_angle):.0f} deg)"
             for i, c in enumerate(res.machine.cylinders)]
-
-
-#: a curve whose largest magnitude is below this fraction of the figure's largest is not drawn:
-#: it would lie on the origin (or the axis) where nobody can see it; a note names it instead
-ZERO_FRACTION = 1e-3
-#: a curve within this fraction of the figure's largest magnitude of an already drawn one is
-#: not drawn: it would hide under that one; the note says it coincides
-COINCIDE_FRACTION = 5e-3
-
-
-def visible_curves(curves):
-    """Split labelled curves into those a reader can see and notes on those left out.
-
-    Parameters
-    ----------
-    curves : list of (str, ndarray)
-        Label and data (any shape; compared element by element, in the same unit).
-
-    Returns
-    -------
-    drawn : list of (str, ndarray)
-        Curves to draw (and only these in the legend).
-    hidden : list of str
-        ``'<label> (zero)'`` or ``'<label> (= <other>)'`` for each curve left out.
-    """
-    scale = max((float(np.max(np.abs(c))) for _, c in curves), default=0.0)
-    drawn, hidden = [], []
-    for label, c in curves:
-        c = np.asarray(c, float)
-        if float(np.max(np.abs(c))) <= ZERO_FRACTION * scale:
-            hidden.append(f"{label} (zero)")
-            continue
-        same = next((k for k, d in drawn if d.shape == c.shape
-                     and float(np.max(np.abs(d - c))) <= COINCIDE_FRACTION * scale), None)
-        if same is not None:
-            hidden.append(f"{label} (= {same})")
-            continue
-        drawn.append((label, c))
-    return drawn, hidden
-
-
-def _hidden_note(ax, hidden) -> None:
-    """Name the curves not drawn, in the lower left corner of the axes."""
-    if hidden:
-        ax.text(0.01, 0.01, "not drawn: " + ", ".join(hidden), transform=ax.transAxes,
-                fontsize=7, color="0.3", va="bottom")
 
 
 def plot_accelerations(res, path):
@@ -161,7 +116,7 @@ def plot_shaking_polar(res, path):
     ax.set_xlabel("F$_x$ (kN)")
     ax.set_ylabel("F$_y$ (kN)")
     ax.set_title("shaking force on the frame over one cycle")
-    _hidden_note(ax, hidden)
+    hidden_note(ax, hidden)
     _finish(plt, fig, (ax,), path)
 
 
@@ -186,7 +141,7 @@ def plot_crank_torque(res, path):
     ax.set_xlabel("crank angle (deg)")
     ax.set_ylabel("torque of the rods on the crankshaft (N m)\n+ in the sense of rotation")
     ax.set_title("crank torque (< 0: taken from the crank, as in a compressor)", fontsize=10)
-    _hidden_note(ax, hidden)
+    hidden_note(ax, hidden)
     _finish(plt, fig, (ax,), path)
 
 

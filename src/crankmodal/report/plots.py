@@ -4,7 +4,8 @@
   Pareto front and recommendation marked, tolerance drawn;
 - :func:`plot_convergence`: frequency of each mode against DOF per (fidelity, order);
 - :func:`plot_mac`: MAC matrix heat map with values;
-- :func:`plot_participation`: effective-mass fractions per mode (x, y, z translations).
+- :func:`plot_participation`: effective-mass fractions per mode (x, y, z translations; a
+  direction no mode moves is named in a note, not drawn).
 """
 
 from __future__ import annotations
@@ -196,17 +197,26 @@ def plot_participation(frequencies_hz, effective_mass, total_mass, path) -> Path
     path = Path(path)
     f = np.asarray(frequencies_hz, float)
     frac = np.asarray(effective_mass, float)[:, :3] / total_mass
+    from ..plotting import ZERO_FRACTION, hidden_note
+
     plt, fig, ax = _figure((7.5, 4.5))
     x = np.arange(len(f))
+    top = float(np.max(np.abs(frac))) if frac.size else 0.0
+    hidden = []
     for c, name in enumerate("xyz"):
+        if float(np.max(np.abs(frac[:, c]), initial=0.0)) <= ZERO_FRACTION * top:
+            hidden.append(f"{name} translation (zero)")  # no bar, no flat line in the legend
+            continue
         ax.bar(x + (c - 1) * 0.27, 100 * frac[:, c], width=0.27, label=f"{name} translation")
         ax.plot(x, 100 * np.cumsum(frac[:, c]), marker=".", lw=1,
                 label=f"{name} cumulative")
+    hidden_note(ax, hidden)
     ax.set_xticks(x, [f"{k + 1}\n{v:.0f} Hz" for k, v in enumerate(f)], fontsize=7)
     ax.set_ylabel("effective mass, % of total")
     ax.set_title("Mode participation: effective mass per mode and cumulative")
     ax.grid(True, axis="y", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    if ax.get_legend_handles_labels()[1]:
+        ax.legend(fontsize=7, ncol=2)
     try:
         savefig_atomic(fig, path, dpi=120)
     finally:
