@@ -49,6 +49,13 @@ def _bad_files(tmp):
     case("pickled", "member 'points'", points=np.array([object()] * P, dtype=object))
     (tmp / "text.npz").write_text("points,shapes\n1,2\n")
     cases["text"] = ("text.npz", "not an .npz archive numpy can read")
+    import meshio
+
+    bad_mode = g["shapes"][:, 0].reshape(P, 3).copy()
+    bad_mode[1, 2] = np.nan
+    meshio.write(tmp / "nan_mode.vtu", meshio.Mesh(g["points"], [("vertex", np.arange(P)[:, None])],
+                                                   point_data={"mode_01_1356.0Hz": bad_mode}))
+    cases["nan_mode"] = ("nan_mode.vtu", "member 'mode_01_1356.0Hz' has 1 NaN")
     np.save(tmp / "single.npy", g["shapes"])
     (tmp / "single.npy").rename(tmp / "single.npz")
     cases["single"] = ("single.npz", "not an .npz archive (a single array)")
@@ -78,7 +85,7 @@ def _scene(tmp, reference):
 
 
 CASES = ["nan_points", "inf_shapes", "no_shapes", "short_shapes", "flat_points", "freq_count",
-         "pickled", "text", "single"]
+         "pickled", "text", "single", "nan_mode"]
 
 
 @pytest.mark.parametrize("name", CASES)
