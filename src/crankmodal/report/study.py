@@ -396,7 +396,7 @@ def write_study(study: SimplificationStudy, out_dir, measured_hz=None, title="",
            f"{study.compared_modes} modes; cost = wall time to mesh and solve. Modes are paired "
            f"with the reference model's by MAC (†: paired out of rank order)."), "",
           study.table_markdown(measured_hz), "",
-          (f"**Recommendation** (tolerance {100 * study.tolerance:.3g} %): "
+          (f"**Recommendation** (tolerance ±{percent(study.tolerance)}): "
            f"{study.recommendation_text()}."), ""]
     if figures:
         md += ["![error against run time](error_vs_time.png)", "",
