@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import NumericalError, ParameterError
 from .damping import (
     DEFAULT_MODAL_DAMPING,
     Damper,
@@ -185,7 +185,14 @@ def harmonic_response(train: DampedTrain, omega, force) -> np.ndarray:
         A = iC[None] * w[:, None, None]
         A += Kc[None]
         A[:, diag, diag] -= w[:, None] ** 2 * m[None]  # M is diagonal (rotors and rings)
-        out[a : a + chunk] = np.linalg.solve(A, F[a : a + chunk, :, None])[..., 0]
+        try:
+            out[a : a + chunk] = np.linalg.solve(A, F[a : a + chunk, :, None])[..., 0]
+        except np.linalg.LinAlgError:
+            raise NumericalError("harmonic_response: the dynamic stiffness is singular at an excitation "
+                                 "frequency (an undamped resonance); add damping") from None
+    if not np.all(np.isfinite(out)):
+        raise NumericalError("harmonic_response: non-finite response (an undamped resonance or "
+                             "non-finite input); add damping")
     return out
 
 

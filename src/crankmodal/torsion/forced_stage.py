@@ -205,9 +205,10 @@ def validate(tp: dict, scene, chain, model) -> dict:
         raise SceneError(f"{KEY}.speed_range_rpm: is required (rpm, [min, max]) when torsion.speed_range_rpm "
                          "and operating_speed_rpm are not given")
     lo = max(rng[0], f["speed_step_rpm"]) if rng[0] <= 0 else rng[0]
+    count = (rng[1] - lo) / f["speed_step_rpm"]
+    if not count < 200_000:
+        raise SceneError(f"{KEY}.speed_step_rpm: gives {count:.3g} speeds in {rng} rpm; at most 200000")
     speeds = np.arange(lo, rng[1] + 1e-9 * rng[1], f["speed_step_rpm"])
-    if len(speeds) > 200_000:
-        raise SceneError(f"{KEY}.speed_step_rpm: gives {len(speeds)} speeds; at most 200000")
     if len(speeds) < 2:
         raise SceneError(f"{KEY}.speed_step_rpm: must leave at least two speeds in {rng}, got {f['speed_step_rpm']:g}")
 
@@ -233,11 +234,19 @@ def validate(tp: dict, scene, chain, model) -> dict:
             with scene_keys(f"{KEY}.pressure_table"):
                 table = PressureTable(np.radians(pt["angle_deg"]), np.asarray(pt["pressure_pa"], float),
                                       2 if pt["cycle_deg"] == 720.0 else 1)
-        with scene_keys(KEY):
-            arrangement = arrangement_of_machine(
-                machine, None if f["cylinder_throws"] is None else [t - 1 for t in f["cylinder_throws"]],
-                None if f["firing_order"] is None else [c - 1 for c in f["firing_order"]],
-                cycle_revolutions=cr)
+        try:
+            with scene_keys(KEY):
+                arrangement = arrangement_of_machine(
+                    machine, None if f["cylinder_throws"] is None else [t - 1 for t in f["cylinder_throws"]],
+                    None if f["firing_order"] is None else [c - 1 for c in f["firing_order"]],
+                    cycle_revolutions=cr)
+                arrangement.firing_angles()  # the order against the angles, checked here
+        except SceneError as exc:
+            if "does not fit in one working cycle" not in str(exc):
+                raise
+            # the order is a permutation, so the cylinders' angles are what does not fit it
+            raise SceneError(f"{exc} -- check the firing order against mechanism.cylinders[i].throw_angle_deg "
+                             "and bank_angle_deg") from None
         ends: list = []
         for i, d in enumerate(f["double_acting"]):
             key = f"{KEY}.double_acting[{i}]"
@@ -267,6 +276,10 @@ def validate(tp: dict, scene, chain, model) -> dict:
                 dampers.append(Damper(d["rotor"] - 1, d["inertia"], d["damping"], d["stiffness"],
                                       d["loss_factor"]))
         train = damped_train(chain, f["modal_damping"], f["rotor_damping"], f["section_damping"], dampers)
+
+    if not (np.any(train.C) or np.any(train.D)):
+        raise SceneError(f"{KEY}.modal_damping: the train has no damping at all (modal, rotor, section or "
+                         "damper), so its response at a resonance is infinite; give modal_damping > 0")
 
     # stress and verdict data
     sections, names = _sections(tp, f, chain, model)

@@ -144,7 +144,8 @@ def build(p: dict):
         stiff = p["stiffnesses"]
     labels = p["labels"] or []
     if labels and len(labels) != len(p["inertias"]):
-        raise SceneError(f"torsion.labels: needs {len(p['inertias'])} names, got {len(labels)}")
+        raise SceneError(f"torsion.labels: needs one name per rotor of inertias ({len(p['inertias'])}), "
+                         f"got {len(labels)}")
     with scene_keys(SECTION):
         chain = TorsionalChain(p["inertias"], stiff, fixed_end=p["fixed_end"], lengths=lengths,
                                labels=list(labels))
