@@ -131,6 +131,7 @@ def test_seed004_train_study_writes_contract_fields_figures_and_report(tmp_path)
      "torsion.forced.sections[0].bore"),
     ("torsion.forced.operating_speeds_rpm=[1900.0]", "torsion.forced.operating_speeds_rpm[0]"),
     ("torsion.forced.speed_band=0.5", "torsion.forced.speed_band"),
+    ("torsion.forced.speed_step_rpm=1e-30", "torsion.forced.speed_step_rpm"),
     ("torsion.forced.double_acting=[{cylinder=1, rod_diameter=0.2}]", "torsion.forced.double_acting[0].rod_diameter"),
     ("torsion.forced.double_acting=[{cylinder=3, rod_diameter=0.03}]", "torsion.forced.double_acting[0].cylinder"),
 ])
@@ -188,3 +189,16 @@ def test_orders_left_out_and_a_viscous_damper_are_warned():
     assert any("viscous damper ring free" in w for w in w12)
     w18 = warnings_of({"max_order": 18.0, "dampers": []})
     assert w18 == []
+
+
+def test_found_by_the_fuzzer_firing_order_against_angles_and_an_undamped_train(tmp_path):
+    # a throw angle that no longer fits the firing order names the angle keys too
+    p = run_cli("check", SCENES / "torsion_inline4_engine.toml", "--set",
+                "mechanism.cylinders.1.throw_angle_deg=0")
+    assert p.returncode == 2 and "torsion.forced.firing_order" in p.stderr
+    assert "mechanism.cylinders[i].throw_angle_deg" in p.stderr and "Traceback" not in p.stderr
+    # no damping anywhere: the resonant response would be infinite
+    p = run_cli("run", SEED, "--out", tmp_path, "--set", "torsion.forced.modal_damping=0",
+                "--set", "torsion.forced.section_damping=[0.0, 0.0, 0.0]")
+    assert p.returncode == 2 and "torsion.forced.modal_damping" in p.stderr
+    assert not (tmp_path / "results.json").exists()
