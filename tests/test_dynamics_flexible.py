@@ -41,7 +41,7 @@ def reduced(tmp_path_factory):
 
 def _run(sysm, q0, qd0, t_end, t_out, rtol=1e-10, atol=1e-12):
     q, qd = sysm.assemble(0.0, q0, qd0)
-    return integrate(sysm, q, qd, t_end, t_out, SolverSettings(rtol=rtol, atol=atol))
+    return integrate(sysm, q, qd, t_end, t_out, SolverSettings(method="RK45", rtol=rtol, atol=atol))
 
 
 def _history(sysm, body, integ):

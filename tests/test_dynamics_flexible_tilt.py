@@ -135,7 +135,7 @@ def _ring(flex, t_end, j, n_out=2001):
     qd0[3 + j] = 0.05
     t_out = np.linspace(0.0, t_end, n_out)
     q, qd = sysm.assemble(0.0, q0, qd0)
-    integ = integrate(sysm, q, qd, t_end, t_out, SolverSettings(rtol=1e-8, atol=1e-13))
+    integ = integrate(sysm, q, qd, t_end, t_out, SolverSettings(method="RK45", rtol=1e-8, atol=1e-13))
     return t_out, integ.y[3 + j]
 
 

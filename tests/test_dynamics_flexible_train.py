@@ -68,7 +68,7 @@ def test_frozen_modes_give_the_rigid_crank_on_one_main_bearing(parts):
     rigid_rods = [RigidBody(r.name, r.mass, r.j0, {n: tuple(r.frames[n][0]) for n in
                                                   ("big", "small")}) for r in rods]
     r_roles = {"mains": ["main_1"], "pins": roles["pins"], "drive": "drive"}
-    settings = SolverSettings(rtol=1e-11, atol=1e-14)
+    settings = SolverSettings(method="RK45", rtol=1e-11, atol=1e-14)
     h_flex = simulate(_train(parts, crank, roles, rods), 0.01, 1e-4, settings)
     h_rig = simulate(_train(parts, rigid_crank, r_roles, rigid_rods), 0.01, 1e-4, settings)
     f, g = h_flex.main_bearing_force, h_rig.main_bearing_force
@@ -84,7 +84,7 @@ def test_energy_balance_counts_the_strain_energy(parts):
     alone (the residual counts strain energy), while the strain energy is not negligible."""
     crank, roles, rods = _flex(parts, 4, 2, zeta=0.0)
     h = simulate(_train(parts, crank, roles, rods), 0.01, 2e-5,
-                 SolverSettings(rtol=1e-9, atol=1e-12))
+                 SolverSettings(method="RK45", rtol=1e-9, atol=1e-12))
     e = h.energy
     assert e["strain"].max() > 1e-3 * np.abs(e["work_drive"]).max() > 0
     assert h.energy_error() < 1e-5
@@ -101,7 +101,7 @@ def test_clearance_at_a_flexible_big_end_runs_with_the_contact_checks(parts):
                               "penetration": 1e-4}}}}
     mech = _train(parts, crank, roles, rods, clearances=spec)
     assert [cj.name for cj in mech.system.clearances] == ["big_end_1"]
-    h = simulate(mech, 0.02, 5e-5, SolverSettings(rtol=1e-6, atol=1e-9))
+    h = simulate(mech, 0.02, 5e-5, SolverSettings(method="RK45", rtol=1e-6, atol=1e-9))
     assert len(h.onsets["big_end_1"]) >= 1
     assert h.contact["big_end_1"]["penetration"].max() > 0
     assert h.energy_error() < 1e-3
@@ -172,7 +172,7 @@ def test_slow_crank_under_a_constant_piston_load_deflects_the_rod_as_the_static_
                    gas_force=lambda angle: F)
     mech = crank_train(parts.radius, [cyl], 6.0, crank_mass=5.0, crank_inertia=0.01,
                        theta0=np.deg2rad(60.0), rod_bodies=[rod])
-    h = simulate(mech, 0.03, 1e-3, SolverSettings(rtol=1e-9, atol=1e-13))
+    h = simulate(mech, 0.03, 1e-3, SolverSettings(method="RK45", rtol=1e-9, atol=1e-13))
     xi = h.modal["rod_1"][-1, :rod.n_elastic]
     d_big, d_small = rod.frames["big"][1], rod.frames["small"][1]
     shortening = -float(((d_small - d_big) @ xi)[0])  # along the body x axis (big -> small)

@@ -72,6 +72,18 @@ def check(name: str, value: Any, field: Field, optional: bool = False) -> Any:
         raise ParameterError(key, text) from None
 
 
+def table_by(name: str, value: Any, schema: Mapping[str, Field]) -> dict:
+    """A dict checked against a scene table's schema (unknown keys, required keys, every
+    value's rule), its defaults filled in; failures name ``name.<key>``."""
+    from .schema import validate
+
+    try:
+        return validate(name, _plain(value) if value is not None else value, schema)
+    except SceneError as exc:
+        key, _, text = str(exc).partition(": ")
+        raise ParameterError(key, text) from None
+
+
 def number(name: str, value: Any, gt=None, ge=None, lt=None, le=None, optional=False) -> float:
     """A finite real number within the bounds given (``optional``: None passes)."""
     return check(name, value, Field("float", gt=gt, ge=ge, lt=lt, le=le), optional)
@@ -126,4 +138,5 @@ def path(name: str, value: Any) -> Any:
     return value
 
 
-__all__ = ["check", "instance", "integer", "number", "numbers", "one_of", "path", "table"]
+__all__ = ["check", "instance", "integer", "number", "numbers", "one_of", "path", "table",
+           "table_by"]

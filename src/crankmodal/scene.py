@@ -141,6 +141,11 @@ def scene_from_dict(
     >>> scene.name, sorted(scene.sections), scene.sections["mechanism"]["speed_rpm"]
     ('api', ['mechanism'], 740)
     """
+    from collections.abc import Mapping
+
+    from .arguments import instance
+
+    instance("data", data, Mapping, "a dict of scene sections ({'torsion': {...}, ...})")
     data = copy.deepcopy(data)
     # A machine named by --set must be known before its defaults are merged; every other
     # override is applied on top of the merged tables, so it can reach into machine lists.
@@ -193,7 +198,9 @@ def load_scene(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) ->
     overrides : sequence of str
         ``section.key=value`` assignments applied before validation.
     """
-    path = Path(path)
+    from .arguments import path as path_argument
+
+    path = Path(path_argument("path", path))
     data = load_toml(path)
     return scene_from_dict(
         data, name=path.stem, base_dir=path.resolve().parent, overrides=overrides, path=path

@@ -122,7 +122,9 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
         (:meth:`~.mechanisms.Mechanism.start_quasi_static`, which replaces ``mech.q0`` and
         ``mech.qd0`` and records ``mech.start_info``), so a run at full speed does not begin
         with a start-up blow; ``undeformed``: ``mech.q0`` as it is (as built: undeformed).
-        No effect on bodies without elastic modes.
+        A state you set yourself (``mech.q0``, ``mech.qd0`` changed since the builder made
+        them, :meth:`~.mechanisms.Mechanism.as_built`) is always run as given. No effect on
+        bodies without elastic modes.
 
     Raises
     ------
@@ -138,7 +140,7 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
     sysm = mech.ideal if ideal else mech.system
     check_output(sysm, t_end, output_step)
     settings = resolved(settings, mech)
-    if (start or mech.start) == "quasi_static" and mech.start_info is None:
+    if (start or mech.start) == "quasi_static" and mech.start_info is None and mech.as_built():
         mech.start_quasi_static()
     for cj in sysm.clearances:
         cj.v_impact = cj.v_impact_min

@@ -91,8 +91,16 @@ class Cylinder:
         Raises
         ------
         ParameterError
-            ``cylinder.throw_angle`` is not 0 (:func:`crank_train` puts every rod on one pin).
+            ``machine`` or ``cylinder`` of the wrong kind, or ``cylinder.throw_angle`` not 0
+            (:func:`crank_train` puts every rod on one pin).
         """
+        for name, value, attrs in (("machine", machine, ("rod",)),
+                                   ("cylinder", cylinder, ("throw_angle", "bank_angle",
+                                                           "piston_mass", "axial_offset"))):
+            if not all(hasattr(value, a) for a in attrs):
+                raise ParameterError(name, f"must be a crankmodal.mechanism.machine "
+                                     f"{'Machine' if name == 'machine' else 'Cylinder'} "
+                                     f"(with {', '.join(attrs)}), got {value!r:.60}")
         if abs(cylinder.throw_angle) > 0.0:
             raise ParameterError("cylinder.throw_angle", "cylinders on separate crank throws are "
                                  f"not supported yet (must be 0, got {cylinder.throw_angle})")
@@ -125,6 +133,14 @@ class Mechanism:
     def __post_init__(self):
         if not self.main_joints:
             self.main_joints = [self.main_joint]
+        self._built = (np.array(self.q0, float), np.array(self.qd0, float))
+
+    def as_built(self) -> bool:
+        """Whether ``q0`` and ``qd0`` are still the state the mechanism was made with (not set
+        by the caller since): only such a state gets :func:`~.analysis.simulate`'s default
+        quasi-static start; a state you set is run as given."""
+        q, qd = self._built
+        return bool(np.array_equal(self.q0, q) and np.array_equal(self.qd0, qd))
 
     def start_quasi_static(self) -> dict:
         """Deform the flexible bodies to rest under the loads at ``t = 0``, as scenes start.
@@ -258,7 +274,8 @@ def _check_common(speed_rpm, theta0, ramp_time, drive_torque, gravity, baumgarte
     from .. import arguments as arg
     from .scene_keys import SCHEMA, SOLVER
 
-    out = {"speed_rpm": arg.check("speed_rpm", speed_rpm, SCHEMA["speed_rpm"]),
+    # as dynamics.speed_rpm, but 0 (the crank held by its drive) is a state the API runs
+    out = {"speed_rpm": arg.number("speed_rpm", speed_rpm, ge=0.0, le=SCHEMA["speed_rpm"].le),
            "theta0": arg.number("theta0", theta0),
            "ramp_time": arg.check("ramp_time", ramp_time, SCHEMA["ramp_time"]),
            "drive_torque": arg.check("drive_torque", drive_torque, SCHEMA["drive_torque"],
@@ -352,7 +369,8 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         m.
     cylinders : list of Cylinder
     speed_rpm : float
-        Crank speed (prescribed, or initial when ``drive_torque`` is given).
+        Crank speed (prescribed, or initial when ``drive_torque`` is given), rpm, in
+        ``[0, 20000]`` (0: the crank held).
     crank_mass, crank_inertia, crank_com : float
         kg, kg m^2 about its centre of mass, and the distance of that centre from the crank axis
         along the crank (negative: counterweight side), m.

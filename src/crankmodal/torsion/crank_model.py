@@ -111,7 +111,26 @@ def crank_model(
         Equivalent-length coefficients (``seed004`` or ``carter``).
     reference_diameter : float, optional
         Default the journal diameter.
+
+    Raises
+    ------
+    ParameterError
+        By the ``[torsion]`` keys' rules (one rule for scenes and this function): naming
+        ``throw.<key>`` or ``flywheel.<key>`` (unknown, missing, out of range; optional keys
+        get the scene's defaults), ``shear_modulus``, ``density``, ``n_throws``, ``form`` or
+        ``reference_diameter``.
     """
+    from .. import arguments as arg
+    from .stage import FLYWHEEL_SCHEMA, SCHEMA, THROW_SCHEMA
+
+    throw = arg.table_by("throw", throw, THROW_SCHEMA)
+    flywheel = arg.table_by("flywheel", flywheel, FLYWHEEL_SCHEMA)
+    shear_modulus = arg.check("shear_modulus", shear_modulus, SCHEMA["G"])
+    density = arg.check("density", density, SCHEMA["density"])
+    n_throws = arg.check("n_throws", n_throws, SCHEMA["n_throws"])
+    form = arg.check("form", form, SCHEMA["equivalent_length_form"])
+    reference_diameter = arg.number("reference_diameter", reference_diameter, gt=0.0,
+                                    optional=True)
     d_ref = throw["journal_diameter"] if reference_diameter is None else reference_diameter
     l_eq = throw_equivalent_length(
         journal_length=throw["journal_length"],
