@@ -235,6 +235,33 @@ def test_damaged_cached_flexbody_is_rebuilt_with_a_warning(tmp_path, monkeypatch
         np.testing.assert_allclose(load_flexbody(again).frequencies_hz, first, rtol=1e-9, atol=0)
 
 
+@pytest.mark.slow
+def test_run_with_a_damaged_cached_flexbody_rebuilds_it_with_one_warning(cli, tmp_path, monkeypatch):
+    """Through `crankmodal run` (a subprocess, warnings shown): before the fix every later run
+    failed (exit 2, or an EOFError traceback for an emptied file) until the user deleted it."""
+    import json
+
+    monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path / "cache"))
+    scene = tmp_path / "bar.toml"
+    scene.write_text('[dynamics]\nmachine = "loom_four_bar"\nend_time = 0.005\n'
+                     '[dynamics.solver]\nmethod = "Radau"\n[dynamics.flexible]\ncoupler = { bar = '
+                     '[0.05, 0.077], mesh_size = 0.025, element_order = 1, fixed_interface_modes = 4 }\n')
+    first = cli("run", scene, "--out", tmp_path / "one", "--no-figures", warnings="default")
+    assert first.returncode == 0, first.stderr
+    (cached,) = (tmp_path / "cache" / "flexbodies").glob("bar_*.npz")
+    cached.write_bytes(cached.read_bytes()[:3000])
+    second = cli("run", scene, "--out", tmp_path / "two", "--no-figures", warnings="default")
+    assert second.returncode == 0, second.stderr
+    damaged = [s for s in second.stderr.splitlines() if "is damaged" in s]
+    assert len(damaged) == 1 and damaged[0].startswith(
+        f"crankmodal: warning: dynamics.flexible.coupler: the cached flexbody {cached}")
+    assert damaged[0].endswith("rebuilding it")
+    peaks = [json.loads((tmp_path / d / "results.json").read_text())["dynamics"]
+             ["main_bearing_force_peak_n"] for d in ("one", "two")]
+    # the same body rebuilt and the same run: equal far above the solvers' round-off
+    assert peaks[1] == pytest.approx(peaks[0], rel=1e-9)
+
+
 def test_damaged_cached_part_is_rebuilt_with_a_warning(tmp_path, monkeypatch):
     from crankmodal.geometry.cache import cache_dir, load_part, store_part
     from crankmodal.fem.testparts import bar
