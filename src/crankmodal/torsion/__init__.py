@@ -33,11 +33,27 @@ Only numpy and scipy are imported here; nothing pulls in gmsh, scikit-fem or pyv
 """
 
 from .chain import ChainModes, TorsionalChain, exact_modes
+from .damping import Damper
+from .excitation import CrankEnd, PressureTable, cylinder_efforts, rotor_excitation
+from .forced import DampedTrain, ForcedResponse, damped_train, energy_balance_amplitude, steady_state
 from .holzer import HolzerResult, holzer, holzer_table
+from .stress import Allowable, Section
 from .two_rotor import TwoRotorResult, reduce_to_two_rotors, two_rotor
 
 __all__ = [
+    "Allowable",
     "ChainModes",
+    "CrankEnd",
+    "DampedTrain",
+    "Damper",
+    "ForcedResponse",
+    "PressureTable",
+    "Section",
+    "cylinder_efforts",
+    "damped_train",
+    "energy_balance_amplitude",
+    "rotor_excitation",
+    "steady_state",
     "HolzerResult",
     "TorsionalChain",
     "TwoRotorResult",

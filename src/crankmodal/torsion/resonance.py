@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from ..errors import ParameterError
 from .forced import energy_balance_amplitude, harmonic_response
 
 
@@ -53,7 +54,10 @@ def resonance_tables(train, response, natural_hz, shapes, excitation, speeds, ma
                 continue
             X = harmonic_response(train, [w], F[None])[0]
             T = B @ X
-            eb = energy_balance_amplitude(train, shapes[m], w, F)
+            try:
+                eb = energy_balance_amplitude(train, shapes[m], w, F)
+            except ParameterError:  # an undamped mode (e.g. a node at the only damper): no estimate
+                eb = None
             ref = int(np.argmax(np.abs(shapes[m])))
             rows = []
             for i in range(train.n_dofs):
@@ -64,7 +68,8 @@ def resonance_tables(train, response, natural_hz, shapes, excitation, speeds, ma
                              "section_torque_nm": float(abs(T[sec[0]])) if sec else None})
             out.append({"mode": m + 1, "order": float(q), "speed_rpm": float(n_c), "natural_hz": float(f),
                         "rows": rows, "reference": train.labels[ref],
-                        "energy_balance_rad": float(eb[ref]), "full_response_rad": float(abs(X[ref])),
+                        "energy_balance_rad": None if eb is None else float(eb[ref]),
+                        "full_response_rad": float(abs(X[ref])),
                         "max_section_torque_nm": float(np.abs(T).max())})
     out.sort(key=lambda t: -t["max_section_torque_nm"])
     out = out[:max_tables]
@@ -76,7 +81,8 @@ def resonance_tables(train, response, natural_hz, shapes, excitation, speeds, ma
 def _text(t: dict) -> str:
     head = (f"Resonance: mode {t['mode']} ({t['natural_hz']:.5g} Hz) x order {t['order']:g} at "
             f"{t['speed_rpm']:.5g} rpm; {t['reference']}: full response {t['full_response_rad']:.4e} rad, "
-            f"energy balance {t['energy_balance_rad']:.4e} rad")
+            + ("no energy-balance estimate (the mode dissipates nothing)" if t["energy_balance_rad"] is None
+               else f"energy balance {t['energy_balance_rad']:.4e} rad"))
     lines = [head, f"{'DOF':<34}{'I kg m2':>12}{'angle rad':>14}{'I w2 th N m':>14}{'section N m':>14}"]
     for r in t["rows"]:
         sec = "" if r["section_torque_nm"] is None else f"{r['section_torque_nm']:14.5g}"
