@@ -324,3 +324,27 @@ def test_simulate_starts_a_flexible_crank_quasi_statically_without_the_start_up_
     assert abs(f_qs[0] / f_rigid[0] - 1.0) < 1e-3
     assert np.max(np.abs(f_qs - f_rigid)) < 0.02 * f_rigid.max()
     assert f_und.max() > 1.5 * f_rigid.max()  # what the default start removes
+
+
+def test_the_mechanism_start_and_a_state_set_by_the_caller_are_respected(bar_crank):
+    """What the [dynamics] stage does for ``flexible.start = "undeformed"`` (``mech.start``),
+    and a caller's own state (``q0`` changed): no quasi-static solve, the state runs as given;
+    a builder's state gets it (its elastic coordinates move off zero: the arm bends)."""
+    crank, _ = cm.crank_body(bar_crank, {"n_modes": 2}, crank_radius=R)
+    c = cyl(gas_force=lambda angle: 3000.0)
+    sl = slice(0, crank.ndof)  # the crank comes first
+    undeformed = cm.crank_train(R, [c], 1500.0, crank_body=crank)
+    undeformed.start = "undeformed"
+    h = cm.simulate(undeformed, 1e-4, 1e-5)
+    assert undeformed.start_info is None and np.all(h.modal["crank"][0] == 0.0)
+    own = cm.crank_train(R, [c], 1500.0, crank_body=crank)
+    own.q0 = own.q0.copy()
+    assert own.as_built()
+    own.q0[sl.start + 3] = 1e-9  # a struck first mode, m kg^1/2
+    assert not own.as_built()
+    h = cm.simulate(own, 1e-4, 1e-5)
+    # the first sample is the state given (copied, not computed: 1e-12 relative is exact enough)
+    assert own.start_info is None and h.modal["crank"][0][0] == pytest.approx(1e-9, rel=1e-12)
+    built = cm.crank_train(R, [c], 1500.0, crank_body=crank)
+    cm.simulate(built, 1e-4, 1e-5)
+    assert built.start_info is not None and np.any(built.q0[sl][3:] != 0.0)
