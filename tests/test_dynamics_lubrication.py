@@ -58,6 +58,7 @@ def test_lubricated_joint_film_carries_a_load_and_books_its_dissipation():
                            law="hertz", law_params={"stiffness": 1e11, "exponent": 1.5},
                            viscosity=MU, bearing_length=L)
     sysm = Multibody([journal], [], [joint], gravity=(0.0, -2000.0))
+    assert sysm.kernel() is not None  # the short film runs in the compiled kernel
     q0, qd0 = np.zeros(3), np.array([0.0, 0.0, 200.0])
     out = integrate(sysm, q0, qd0, 0.01, None, SolverSettings(method="LSODA", rtol=1e-7,
                                                              atol=1e-14))
@@ -69,3 +70,34 @@ def test_lubricated_joint_film_carries_a_load_and_books_its_dissipation():
     ke, pe = sysm.energy(y[:3], y[3:6])
     d_contact = y[6 + AUX_NAMES.index("dissipated_contact")]
     assert (ke + pe) - sum(ke0) == pytest.approx(-d_contact, abs=1e-9 * ke0[0])
+
+
+@pytest.mark.parametrize("eps,eps_dot,gamma,gamma_dot,omega", [
+    (0.6, 3.0, 0.7, 40.0, 300.0),
+    (0.3, -8.0, -2.5, -120.0, 150.0),
+])
+def test_joint_film_force_is_the_short_bearing_force_of_its_polar_kinematics(eps, eps_dot, gamma,
+                                                                            gamma_dot, omega):
+    # Oracle: a journal centre at e = eps c (cos gamma, sin gamma) moving with
+    # v = c eps_dot n + eps c gamma_dot t is the film of short_bearing_force(eps, eps_dot,
+    # gamma_dot, omega) in the frame (n, t). The joint turns its kinematics into the film's
+    # arguments (lubrication.film_arguments, without gamma_dot) on both paths: ClearanceJoint's
+    # film_force and the compiled kernel's contact force (no dry contact inside the clearance).
+    ground = Ground(frames={"bore": (0.0, 0.0)})
+    journal = RigidBody("journal", 1.0, 1e-3, {"centre": (0.0, 0.0)})
+    joint = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=C, journal_radius=R,
+                           law="hertz", law_params={"stiffness": 1e11, "exponent": 1.5},
+                           viscosity=MU, bearing_length=L)
+    sysm = Multibody([journal], [], [joint])
+    n = np.array([np.cos(gamma), np.sin(gamma)])
+    t = np.array([-n[1], n[0]])
+    q = np.array([*(eps * C * n), 0.4])
+    qd = np.array([*(C * eps_dot * n + eps * C * gamma_dot * t), omega])
+    fr, ft = short_bearing_force(eps, eps_dot, gamma_dot, omega, MU, R, L, C)
+    expected = fr * n + ft * t
+    python = joint.film_force(joint.kinematics(sysm, q, qd))
+    assert sysm.kernel() is not None
+    kernel = sysm.solve(0.0, q, qd)["contacts"][0]["force"]
+    scale = np.hypot(fr, ft)
+    np.testing.assert_allclose(python, expected, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(kernel, expected, rtol=0, atol=1e-12 * scale)

@@ -14,21 +14,28 @@ from crankmodal.dynamics import Cylinder, contact, crank_train, laws
 from crankmodal.dynamics.analysis import simulate
 from crankmodal.dynamics.bodies import Ground, RigidBody
 from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.simulate import SolverSettings
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.simulate import SolverSettings, integrate
+from crankmodal.dynamics.system import AUX_NAMES, Multibody
 
 PARAMS = {"stiffness": 2e10, "exponent": 1.4, "damping": 800.0, "penetration": 5e-5,
           "restitution": 0.7, "radial_clearance": 1e-4}
 FRICTION = {"mu_static": 0.12, "mu_dynamic": 0.08, "v_static": 1e-4, "v_dynamic": 1e-2}
 
 
-def _slider_crank(law, friction, params=PARAMS):
+#: the big end's bore variants: round and dry (the default), worn (seed 003's elliptical bore,
+#: major axis 40 deg off the rod), lubricated (seed 001's short-bearing film, round bore)
+BORES = {"round": {}, "worn": {"clearance_major": 1.6e-4, "wear_angle": 0.7},
+         "film": {"viscosity": 0.0175, "bearing_length": 0.03}}
+
+
+def _slider_crank(law, friction, params=PARAMS, bore="round"):
     cyls = [Cylinder(axis_angle=a, rod_length=0.14, rod_mass=0.9, rod_inertia=3.1e-3,
                      rod_com=0.042, piston_mass=0.75, ring_friction=30.0,
                      gas_force=lambda x: 2000 + 1500 * np.cos(x)) for a in (0.0, 1.2)]
     kw = {"law": law, "law_params": params, "friction": friction, "friction_params": FRICTION}
     return crank_train(0.035, cyls, 3000.0, crank_mass=2.0, crank_inertia=0.01,
-                       clearances={"big_end_1": {"clearance": 1e-4, "journal_radius": 0.02}},
+                       clearances={"big_end_1": {"clearance": 1e-4, "journal_radius": 0.02,
+                                                 **BORES[bore]}},
                        contact_kw=kw, gravity=(0.0, -9.81))
 
 
@@ -65,16 +72,15 @@ def _both(sysm, fn, *args):
     return a, b
 
 
-@pytest.mark.parametrize("friction", contact.FRICTION_LAWS)
-@pytest.mark.parametrize("law", contact.NORMAL_LAWS)
-def test_compiled_rhs_and_solve_equal_the_python_path_state_by_state(law, friction):
-    mech = _slider_crank(law, friction)
+def _paths_agree_state_by_state(mech, seed, count):
+    """Both paths' right-hand sides, multipliers, constraint terms and contact diagnostics agree
+    at ``count`` random states; returns the number of states in contact and of the film's."""
     sysm = mech.system
     assert sysm.kernel() is not None
     cj = sysm.clearances[0]
     n = sysm.n
-    in_contact = 0
-    for t, q, qd, y, v_impact in _states(mech, 7, 12):
+    in_contact = film = 0
+    for t, q, qd, y, v_impact in _states(mech, seed, count):
         cj.v_impact = v_impact  # restitution laws read it at each call
         py, co = _both(sysm, sysm.rhs, t, y)
         scale = np.maximum(np.abs(py), 1e-300)
@@ -91,21 +97,52 @@ def test_compiled_rhs_and_solve_equal_the_python_path_state_by_state(law, fricti
         _close(sc["p_loads"], sp["p_loads"], np.max(np.abs(py[2 * n:])) + abs(sp["p_loads"]),
                "p_loads")
         kp, kc = sp["contacts"][0], sc["contacts"][0]
-        # the contact's own scales: a length (the clearance, m), a speed, a force
-        length, force = cj.clearance, max(abs(kp["fn"]), abs(kp["ft"]), 1.0)
+        # the contact's own scales: a length (the clearance, m), a speed, a force (the film's
+        # too), and for a worn bore's d(clearance)/d(angle) the difference of its axes
+        length = cj.clearance_major or cj.clearance
+        force = max(abs(kp["fn"]), abs(kp["ft"]), kp["film"], 1.0)
         for key, scale in (("delta", length), ("d", length), ("r_b", length + cj.journal_radius),
-                           ("delta_dot", v_scale), ("v_slip", v_scale), ("v_elastic", v_scale),
-                           ("omega_sum", v_scale), ("fn", force), ("ft", force),
-                           ("p_damp", force * v_scale), ("p_fric", force * v_scale)):
+                           ("dtheta", length), ("delta_dot", v_scale), ("v_slip", v_scale),
+                           ("v_elastic", v_scale), ("omega_sum", v_scale), ("fn", force),
+                           ("ft", force), ("film", force), ("p_damp", force * v_scale),
+                           ("p_fric", force * v_scale)):
             _close(kc[key], kp[key], scale, key)
-        for key, scale in (("e", length), ("n", 1.0), ("t", 1.0), ("force", force),
-                           ("vrel", v_scale), ("Jj", 1.0 + q_scale), ("Jb", 1.0 + q_scale)):
+        for key, scale in (("e", length), ("n", 1.0), ("t", 1.0), ("grad", 1.0),
+                           ("force", force), ("vrel", v_scale), ("Jj", 1.0 + q_scale),
+                           ("Jb", 1.0 + q_scale)):
             _close(kc[key], kp[key], scale, key)
         _close(sysm.gap(0, q), cj.gap(sysm, q), length, "gap")
         _close(sysm.penetration_rate(0, q, qd), cj.kinematics(sysm, q, qd)["delta_dot"], v_scale,
                "penetration rate")
         in_contact += kp["delta"] > 0.0 and kp["fn"] > 0.0
+        film += kp["film"] > 0.0
+    return in_contact, film
+
+
+@pytest.mark.parametrize("friction", contact.FRICTION_LAWS)
+@pytest.mark.parametrize("law", contact.NORMAL_LAWS)
+def test_compiled_rhs_and_solve_equal_the_python_path_state_by_state(law, friction):
+    in_contact, _ = _paths_agree_state_by_state(_slider_crank(law, friction), 7, 12)
     assert in_contact >= 3
+
+
+# every normal law once, the friction laws in turn: the bore's terms do not depend on the pair
+@pytest.mark.parametrize("law,friction", [
+    (law, contact.FRICTION_LAWS[i % len(contact.FRICTION_LAWS)])
+    for i, law in enumerate(contact.NORMAL_LAWS)])
+@pytest.mark.parametrize("bore", ["worn", "film"])
+def test_worn_bores_and_short_films_compiled_equal_the_python_path_state_by_state(bore, law,
+                                                                                  friction):
+    """The kernel's worn bore (the gradient n - (c'/d) t, the rate's c' omega_bearing, the
+    bearing's moment -fn c') and short-bearing film (force, its power booked as dissipation)
+    against ClearanceJoint's own, at random states in and out of contact (the worn bore's
+    clearance and the film's formula are the same Numba functions on both paths: their oracles
+    are seed 003's ellipse in test_dynamics_worn and the integrated Reynolds pressure in
+    test_dynamics_lubrication)."""
+    mech = _slider_crank(law, friction, bore=bore)
+    in_contact, film = _paths_agree_state_by_state(mech, 7, 16)
+    assert 3 <= in_contact <= 15  # in contact and out of it
+    assert film == (16 if bore == "film" else 0)
 
 
 def test_a_smooth_run_is_the_same_on_both_paths():
@@ -126,6 +163,43 @@ def test_a_smooth_run_is_the_same_on_both_paths():
                  (co.piston_acceleration, py.piston_acceleration),
                  *((co.energy[k], py.energy[k]) for k in ("work_drive", "work_loads", "kinetic"))):
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-6 * np.max(np.abs(b)))
+
+
+def test_a_smooth_lubricated_run_is_the_same_on_both_paths():
+    """The big end floating on seed 001's short-bearing film (c = 0.021 mm, no dry contact in
+    0.01 s: a smooth run, no impacts to amplify round-off), kernel against Python path sample
+    by sample. LSODA keeps each step's error within rtol |y_i| + atol; the two paths' steps
+    differ by round-off (and LSODA may switch method at other steps), so their histories differ
+    by the integrator's error: positions, velocities and works within 100 x (rtol max|y_i| +
+    atol) (seen: up to 53 x, the drive's work). The film's dissipation is more sensitive: the
+    eccentricity is known to rtol |q| ~ 1e-9 m, 5e-5 of the clearance, and the film force
+    grows as (1 - eps^2)^-2: within 1e-4 of its value (seen: 6.5e-6). The ideal joints' work is
+    drift (zero up to round-off) and not compared. A model difference (a film term's sign or
+    factor, its power) moves the journal by a fraction of the clearance, the film's dissipation
+    by O(1)."""
+    rtol, atol = 1e-8, 1e-13
+    t_out = np.linspace(0.0, 0.01, 101)
+    runs = []
+    for compiled in (False, True):
+        mech = _slider_crank("hertz", "none", bore="film")
+        mech.system.clearances[0].clearance = 2.1e-5
+        mech.system.compiled = compiled
+        assert (mech.system.kernel() is not None) == compiled
+        runs.append(integrate(mech.system, mech.q0, mech.qd0, 0.01, t_out,
+                              SolverSettings(method="LSODA", rtol=rtol, atol=atol)))
+    py, co = runs
+    assert py.onsets == co.onsets == [[]]  # the film carries the load: no dry contact
+    cj, sysm, n = mech.system.clearances[0], mech.system, mech.system.n
+    eps = [cj.kinematics(sysm, y[:n], y[n:2 * n])["d"] / cj.clearance for y in py.y.T]
+    assert 0.3 < max(eps) < cj.eps_max  # a loaded film
+    assert py.y[2 * n + AUX_NAMES.index("dissipated_contact"), -1] > 0.0  # the film's power
+    size = np.max(np.abs(py.y), axis=1)
+    bound = 100.0 * (rtol * size + atol)
+    i_ideal, i_film = (2 * n + AUX_NAMES.index(k) for k in ("work_constraints",
+                                                            "dissipated_contact"))
+    bound[i_film] = 1e-4 * size[i_film]
+    bound[i_ideal] = np.inf
+    assert np.all(np.abs(co.y - py.y) <= bound[:, None])
 
 
 def test_a_free_journal_without_constraints_is_compiled_too():

@@ -1,4 +1,5 @@
-"""Seed 003's worn (elliptical) con-rod bearing: bore geometry and penetration rate."""
+"""Seed 003's worn (elliptical) con-rod bearing: bore geometry and penetration rate, on the
+Python path (ClearanceJoint) and in the compiled kernel (Multibody.gap, penetration_rate)."""
 
 import numpy as np
 import pytest
@@ -32,6 +33,7 @@ def _seed_penetration(x12, y12, rod_angle, gamma):
 @pytest.mark.parametrize("gamma", [0.0, 0.4, -1.2])
 def test_worn_bore_penetration_is_seed_003s_ellipse_in_the_rod_frame(gamma):
     sysm, joint = _worn_pair(gamma)
+    assert sysm.kernel() is not None  # Multibody.gap: the compiled kernel
     rng = np.random.default_rng(3)
     for _ in range(20):
         rod_angle = rng.uniform(-np.pi, np.pi)
@@ -40,12 +42,14 @@ def test_worn_bore_penetration_is_seed_003s_ellipse_in_the_rod_frame(gamma):
         # the seed's (x12, y12) point from the journal to the bore: the ellipse is symmetric
         expected = _seed_penetration(-e[0], -e[1], rod_angle, gamma)
         assert joint.gap(sysm, q) == pytest.approx(expected, abs=1e-12)
+        assert sysm.gap(0, q) == pytest.approx(expected, abs=1e-12)
 
 
 def test_worn_bore_penetration_rate_is_the_time_derivative_of_the_penetration():
     # journal and a spinning rod moving on smooth paths: the joint's delta_dot against a central
     # difference of its gap (the rod's rotation turns the ellipse under the journal)
     sysm, joint = _worn_pair(0.3)
+    assert sysm.kernel() is not None
 
     def state(t):
         q = np.array([0.01 * np.sin(40 * t), 0.0, 2.0 + 60.0 * t,
@@ -63,3 +67,4 @@ def test_worn_bore_penetration_rate_is_the_time_derivative_of_the_penetration():
         fd = (joint.gap(sysm, state(t + h)[0]) - joint.gap(sysm, state(t - h)[0])) / (2 * h)
         assert k["delta"] == pytest.approx(joint.gap(sysm, q), abs=1e-15)
         assert k["delta_dot"] == pytest.approx(fd, rel=1e-6, abs=1e-9)
+        assert sysm.penetration_rate(0, q, qd) == pytest.approx(fd, rel=1e-6, abs=1e-9)
