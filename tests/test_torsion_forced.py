@@ -174,3 +174,19 @@ def test_negative_damping_and_bad_rotor_are_refused_naming_the_argument():
         damped_train(chain, dampers=[Damper(7, 0.1, damping=10.0)])
     with pytest.raises(ParameterError, match=r"harmonics\[0\].order"):
         rotor_excitation(4, 6.0, 1, harmonics=[{"rotor": 0, "order": 1.5, "amplitude": 1.0}])
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda tr, ex: rotor_excitation("4", 6.0, 2), "n_rotors"),
+    (lambda tr, ex: rotor_excitation(4, 6.0, 3), "cycle_revolutions"),
+    (lambda tr, ex: rotor_excitation(4, 6.0, 2, harmonics=[{"rotor": 0, "order": 1.0}]), r"harmonics\[0\].amplitude"),
+    (lambda tr, ex: steady_state(tr, None, [100.0]), "excitation"),
+    (lambda tr, ex: steady_state(tr, ex, [100.0, float("nan")]), r"speed_rpm\[1\]"),
+    (lambda tr, ex: steady_state([1.0], ex, [100.0]), "train"),
+    (lambda tr, ex: damped_train([0.4, 0.25]), "chain"),
+])
+def test_api_arguments_of_the_wrong_type_name_the_argument(call, name):
+    train = damped_train(_chain4())
+    ex = rotor_excitation(4, 6.0, 2, harmonics=[{"rotor": 0, "order": 1.0, "amplitude": 1.0}])
+    with pytest.raises(ParameterError, match=name):
+        call(train, ex)

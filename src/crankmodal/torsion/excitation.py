@@ -256,8 +256,14 @@ def cylinder_efforts(machine, arrangement=None, pressure_table: PressureTable | 
     from ..mechanism.analysis import analyse
     from ..mechanism.kinematics import kinematic_ratio
 
-    if n_per_rev < 36:
-        raise ParameterError("n_per_rev", f"must be >= 36, got {n_per_rev}")
+    from .. import arguments as arg
+    from ..mechanism.machine import Machine
+
+    arg.instance("machine", machine, Machine, "a crankmodal.mechanism.machine.Machine")
+    n_per_rev = arg.integer("n_per_rev", n_per_rev, ge=36, le=100_000)
+    if pressure_table is not None:
+        arg.instance("pressure_table", pressure_table, PressureTable, "a PressureTable")
+    crank_ends = tuple(arg.instance(f"crank_ends[{i}]", e, CrankEnd, "a CrankEnd") for i, e in enumerate(crank_ends))
     if arrangement is not None:
         machine = arrangement.apply(machine)
         throws = np.asarray(arrangement.cylinder_throws, int)
@@ -379,6 +385,15 @@ def rotor_excitation(n_rotors: int, max_order: float, cycle_revolutions: int,
         ``harmonics[i].order`` not a multiple of ``1 / cycle_revolutions`` or above ``max_order``,
         ``harmonics[i].rotor`` out of range, ``throw_rotors`` wrong.
     """
+    from .. import arguments as arg
+    from ..schema import Field
+
+    n_rotors = arg.integer("n_rotors", n_rotors, ge=1)
+    cycle_revolutions = arg.one_of("cycle_revolutions", cycle_revolutions, (1, 2))
+    max_order = arg.number("max_order", max_order, gt=0.0, le=100.0)
+    schema = {"rotor": Field("int", doc="0-based rotor", ge=0), "order": Field("float", doc="order", gt=0.0),
+              "amplitude": Field("float", doc="N m", ge=0.0), "phase_deg": Field("float", 0.0, "deg")}
+    harmonics = [arg.table_by(f"harmonics[{i}]", h, schema) for i, h in enumerate(harmonics)]
     kmax = int(math.floor(max_order * cycle_revolutions + 1e-9))
     if kmax < 1:
         raise ParameterError("max_order", f"must be >= {1 / cycle_revolutions:g}, got {max_order}")
@@ -386,6 +401,9 @@ def rotor_excitation(n_rotors: int, max_order: float, cycle_revolutions: int,
     gas = np.zeros((kmax, n_rotors), complex)
     inertia = np.zeros((kmax, n_rotors), complex)
     if efforts is not None:
+        arg.instance("efforts", efforts, CylinderEfforts, "a CylinderEfforts (cylinder_efforts(...))")
+        if throw_rotors is None:
+            raise ParameterError("throw_rotors", "is required with efforts (0-based rotor of each throw)")
         if efforts.cycle_revolutions != cycle_revolutions:
             raise ParameterError("cycle_revolutions", "differs from the machine's working cycle")
         P = throw_to_rotor_matrix(efforts.cylinder_throws, throw_rotors, n_rotors)

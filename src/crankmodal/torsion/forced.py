@@ -122,6 +122,11 @@ def damped_train(chain, modal_damping: float = DEFAULT_MODAL_DAMPING, rotor_damp
         Naming ``modal_damping``, ``rotor_damping[i]``, ``section_damping[i]`` (negative, wrong
         length) or ``dampers[i].rotor``.
     """
+    from .. import arguments as arg
+    from .chain import TorsionalChain
+
+    arg.instance("chain", chain, TorsionalChain, "a TorsionalChain")
+    modal_damping = arg.number("modal_damping", modal_damping, ge=0.0, lt=1.0)
     n = chain.n_rotors
     n_sec = len(chain.stiffnesses)
     if chain.fixed_end:
@@ -309,9 +314,15 @@ def steady_state(train: DampedTrain, excitation, speed_rpm) -> ForcedResponse:
     ParameterError
         ``speed_rpm`` not > 0, or an excitation sized for another number of rotors.
     """
-    speed = np.atleast_1d(np.asarray(speed_rpm, float))
-    if not np.all(np.isfinite(speed)) or np.any(speed <= 0):
-        raise ParameterError("speed_rpm", "must be > 0 rpm")
+    from .. import arguments as arg
+    from .excitation import RotorExcitation
+
+    arg.instance("train", train, DampedTrain, "a DampedTrain (damped_train(...))")
+    arg.instance("excitation", excitation, RotorExcitation, "a RotorExcitation (rotor_excitation(...))")
+    speed = np.asarray(arg.numbers("speed_rpm", np.atleast_1d(np.asarray(speed_rpm, dtype=object)).tolist(),
+                                   gt=0.0), float)
+    if not len(speed):
+        raise ParameterError("speed_rpm", "needs at least one speed")
     if excitation.gas.shape[1] != train.n_rotors:
         raise ParameterError("excitation", f"has {excitation.gas.shape[1]} rotors, the train {train.n_rotors}")
     Omega = speed * math.pi / 30.0
