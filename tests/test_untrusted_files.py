@@ -80,6 +80,23 @@ def flip_in(member):
     return damage
 
 
+def huge_header(member):
+    """``member`` replaced by an .npy whose header declares 1e12 float64 values (8 TB)."""
+    def damage(good, out):
+        import io
+
+        d = members(good)
+        del d[member]
+        with open(out, "wb") as fh:
+            np.savez(fh, **d)
+        buf = io.BytesIO()
+        np.lib.format.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False,
+                                                   "shape": (10**12,)})
+        with zipfile.ZipFile(out, "a") as zf:
+            zf.writestr(f"{member}.npy", buf.getvalue() + bytes(64))
+    return damage
+
+
 def _set(name, value):
     return lambda d: d.__setitem__(name, value)
 
@@ -92,6 +109,7 @@ DAMAGES = {
     "a bare npy": (lambda g, o: np.save(open(o, "wb"), np.zeros(3)), ""),
     "bit-flipped I9": (flip_in("I9"), "I9"),
     "bit-flipped interface_map": (flip_in("interface_map"), "interface_map"),
+    "8 TB declared": (huge_header("frequencies_hz"), "frequencies_hz"),
     "version not a number": (lambda g, o: rewrite(g, o, _set("version", np.array("one"))), "version"),
     "version 2": (lambda g, o: rewrite(g, o, _set("version", np.array(2))), "version"),
     "pickled names": (lambda g, o: rewrite(g, o, _set(

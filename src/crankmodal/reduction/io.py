@@ -159,6 +159,8 @@ class _Members:
             raise self.fail(name, f"unreadable ({exc})") from None
         except (OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
             raise self.fail(name, f"unreadable, the file is damaged ({exc})") from None
+        except MemoryError:  # a header declaring an absurd shape
+            raise self.fail(name, "declares an array larger than the memory available") from None
 
     def text(self, name: str, choices=None) -> str:
         a = self.raw(name)
