@@ -68,9 +68,14 @@ def not_below(a, b, k=2.0):
 
 
 @pytest.mark.slow
-def test_seed000_larger_big_end_clearance_gives_larger_piston_acceleration_peaks():
-    # the largest piston acceleration after 0.05 s, per trajectory; asserted on the ensemble
-    # means against their standard errors (a single pair of trajectories had asserted 1.5x)
+def test_seed000_big_end_clearance_lifts_piston_acceleration_peaks_far_above_ideal():
+    # the largest piston acceleration after 0.05 s (no ramp, 40 mm pin), per trajectory. One
+    # pair of trajectories had asserted 1.5x; the ensemble shows regimes instead: 0.10 mm gave
+    # 8.1 / 5.5 / 5.6 / 21.6 km/s^2, 0.20 mm 58.4 / 5.8 / 5.9 / 50.5 km/s^2 (means 10.2 +- 3.8
+    # and 30.1 +- 14.1): the larger clearance rattles more often, but 4 trajectories do not
+    # separate the means by 2 standard errors. Asserted here: every trajectory far above the
+    # ideal-joint 916 m/s^2 and no significant reversal; the clearance trend itself is asserted
+    # with the seed's ramp and pin by the Fig. 24/26 test below (13 +- 4.5 vs 58 +- 1.5 km/s^2).
     def peak(c):
         def one(k):
             h = _run("four_star_dynamics.toml", [
@@ -81,7 +86,8 @@ def test_seed000_larger_big_end_clearance_gives_larger_piston_acceleration_peaks
         return ensemble(one)["peak"]
 
     small, large = peak(1.0e-4), peak(2.0e-4)
-    assert clearly_above(large, small)
+    assert small[2].min() > 3.0 * 916.0 and large[2].min() > 3.0 * 916.0
+    assert not_below(large, small)
 
 
 @pytest.mark.slow
