@@ -138,6 +138,7 @@ def test_every_public_name_is_in_the_api_reference(site):
             continue
         assert (site / "reference" / "generated" / f"crankmodal.{name}.html").exists(), name
         assert f"crankmodal.{name}.html" in text, name
+        assert (getattr(crankmodal, name).__doc__ or "").strip(), f"{name} has no docstring"
 
 
 def test_main_entry_points_carry_examples_and_their_doctests_pass():
