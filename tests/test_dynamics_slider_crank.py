@@ -72,10 +72,11 @@ def ideal_history():
                     ideal=True)
 
 
-def test_ideal_slider_crank_bearing_forces_equal_newton_euler_inverse_dynamics(ideal_history):
+def test_ideal_slider_crank_bearing_forces_equal_newton_euler_inverse_dynamics(oracle, ideal_history):
     h = ideal_history
     ref = np.array([np.concatenate(_newton_euler(th)[:2]) for th in h.crank_angle])
     scale = np.abs(ref).max()
+    oracle(stage="dynamics", quantity="ideal slider-crank main-bearing force, largest deviation over the cycle / peak", reference="Newton-Euler inverse dynamics (second formulation)", tolerance="1e-5 of peak", measured=np.abs(h.main_bearing_force - ref[:, :2]).max() / scale, expected=0.0)
     np.testing.assert_allclose(h.main_bearing_force, ref[:, :2], atol=1e-5 * scale)
     np.testing.assert_allclose(h.joint_forces["big_end_1"], ref[:, 2:], atol=1e-5 * scale)
 

@@ -95,7 +95,7 @@ def _uniform_shaft(n_elem, L, d, G, rho, fixed):
 
 
 @pytest.mark.parametrize("fixed", [False, True])
-def test_discretised_uniform_shaft_converges_to_continuum_at_second_order(fixed):
+def test_discretised_uniform_shaft_converges_to_continuum_at_second_order(oracle, fixed):
     # Continuous shaft: free-free f_n = n c / (2 L), fixed-free f_n = (2n - 1) c / (4 L), c = sqrt(G/rho).
     # Lumped inertias converge from below with error ~ (n pi h / 2L)^2 / 6: observed order 2.
     L, d, G, rho = 1.2, 0.05, 8.0e10, 7850.0
@@ -109,6 +109,7 @@ def test_discretised_uniform_shaft_converges_to_continuum_at_second_order(fixed)
     errs = np.array(errs)
     assert np.all(errs < 0)  # lumped mass: frequencies from below
     order = np.log2(errs[-2] / errs[-1])
+    oracle(stage="torsion", quantity=f"lumped uniform shaft ({'fixed-free' if fixed else 'free-free'}), observed order of convergence, mode 1", reference="continuum shaft n c / 2L: second order", tolerance="0.02", measured=order[0], expected=2.0)
     np.testing.assert_allclose(order, 2.0, atol=0.02)
     assert np.all(np.abs(errs[-1]) < 2.5e-4)  # mode 3, 160 elements: (3 pi / 320)^2 / 6 = 1.4e-4
     # Holzer on the same 40-element chain finds the same lowest frequencies
