@@ -1,6 +1,8 @@
 """Reports of crankmodal analyses: modal reports, mesh-simplification studies, renders.
 
-Modules: :mod:`.mac` (modal assurance criterion), :mod:`.render` (off-screen pyvista
+Modules: :mod:`.mac` (modal assurance criterion), :mod:`.reference` (reference mode shapes
+read from an untrusted file and checked whole), :mod:`.quantity` (every printed number:
+engineering prefixes, en-dash ranges, no exponent notation), :mod:`.render` (off-screen pyvista
 mode-shape and stress renders), :mod:`.plots` (matplotlib figures with CSV data),
 :mod:`.study` (fidelity x mesh size x element order studies, Pareto front, recommendation),
 :mod:`.modal_report` (self-contained HTML and Markdown), :mod:`.scene_report` (the report of
