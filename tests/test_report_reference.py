@@ -126,5 +126,6 @@ def test_the_core_loader_names_its_argument_and_reads_a_good_file(bad):
     _write_npz(tmp / "good.npz", **{**g, "shapes": g["shapes"].reshape(P, 3, 2)})
     pts, shapes, f = load_reference(tmp / "good.npz")
     assert pts.shape == (P, 3) and f.tolist() == [1356.0, 1489.0]
-    # (p, 3, k) is read node-interleaved: row 3 i + c is point i, component c
+    # (p, 3, k) is read node-interleaved: row 3 i + c is point i, component c (a reshape and
+    # a float64 copy, no arithmetic: equal bit for bit by construction)
     np.testing.assert_array_equal(shapes, g["shapes"])
