@@ -44,16 +44,28 @@ WITH_EXAMPLES = ("scene_from_dict", "check_scene", "load_machine", "list_machine
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
-    """Build the site once (html, warnings as errors, no network); the output folder."""
+    """Build the site once (html, warnings as errors, no network); the output folder.
+
+    The build runs on a snapshot of the source tree (docs/ and what its pages include), so that
+    the pages it generates do not land in the working tree and another build running at the
+    same time cannot interleave with this one."""
+    import shutil
+
     out = tmp_path_factory.mktemp("site")
+    tree = out / "tree"
+    shutil.copytree(REPO, tree, ignore=shutil.ignore_patterns(
+        ".git", ".venv", "out", "__pycache__", "_build", "*.egg-info", ".cache", ".pytest_cache",
+        ".hypothesis", "generated", "*.nbi", "*.nbc"))
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONWARNINGS="ignore")
     # the quick notebooks are not executed here (tests/test_notebooks.py runs them; the real build
     # does, 2-3 min more): the build is checked with their committed or executed-copy outputs
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONWARNINGS="ignore", CRANKMODAL_DOCS_EXECUTE="0")
+    env["CRANKMODAL_DOCS_EXECUTE"] = "0"
+    env["PYTHONPATH"] = os.pathsep.join([str(tree / "src"), env.get("PYTHONPATH", "")])
     # no proxy either: a build that tried the network would fail here, not hang
     env.update(http_proxy="http://0.0.0.0:9", https_proxy="http://0.0.0.0:9")
     proc = subprocess.run(
         [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "html", "-q",
-         "-d", str(out / "doctrees"), str(DOCS), str(out / "html")],
+         "-d", str(out / "doctrees"), str(tree / "docs"), str(out / "html")],
         env=env, capture_output=True, text=True, timeout=900, check=False)
     assert proc.returncode == 0, proc.stderr[-6000:]
     return out / "html"
