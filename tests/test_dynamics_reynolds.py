@@ -276,3 +276,33 @@ def test_unknown_film_model_is_rejected_with_the_admissible_values():
                        film_model="long")
     with pytest.raises(ValueError, match="eps"):
         solve_pressure(1.0, 1.0)
+
+
+def test_a_damaged_cached_film_table_is_solved_again_with_one_warning(tmp_path, monkeypatch):
+    # a small table (2 x 3 nodes, 16 x 4 grid) keeps this quick; the cache logic is the same
+    import warnings
+
+    from crankmodal.dynamics import reynolds
+    from crankmodal.errors import ModelWarning
+
+    monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path))
+    monkeypatch.setattr(reynolds, "EPS_TABLE", np.array([0.3, 0.6]))
+    monkeypatch.setattr(reynolds, "ALPHA_TABLE", np.array([-1.0, 0.0, 1.0]))
+    first = reynolds._table_values(1.0, 16, 4)
+    (entry,) = (tmp_path / "film_tables").glob("*.npz")
+    # the cached values are the direct solves at the nodes
+    s = 1.0 - 0.6**2
+    direct = solve_pressure(0.6, 1.0, np.cos(1.0) * s**2 / 0.6, np.sin(1.0) * s**2.5, 16, 4)[2]
+    np.testing.assert_allclose(first[1, 2], direct, rtol=1e-12)
+    for damage in (b"", b"not a zip file", entry.read_bytes()[:100]):
+        entry.write_bytes(damage)
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            again = reynolds._table_values(1.0, 16, 4)
+        said = [w for w in seen if issubclass(w.category, ModelWarning)]
+        assert len(said) == 1 and "solved again" in str(said[0].message)
+        np.testing.assert_allclose(again, first, rtol=1e-12)
+    # a well-formed entry of the wrong shape or with a NaN is damaged too
+    np.savez(entry, forces=np.full((2, 3, 2), np.nan))
+    with pytest.warns(ModelWarning, match="not finite"):
+        reynolds._table_values(1.0, 16, 4)
