@@ -474,11 +474,14 @@ def part_scenes():
 
 def length_mutations(scene_file) -> list[tuple[str, str]]:
     """``geometry.params.<length>`` x :data:`HUGE_AND_SUBNORMAL` of a part scene."""
-    from crankmodal.geometry.params import PART_TYPES, length_fields
+    import dataclasses
+
+    from crankmodal.geometry.params import PART_TYPES
 
     geo = load_scene(scene_file).sections["geometry"]
     part = geo.get("part", "crankshaft")
-    names = length_fields(PART_TYPES[part]())
+    names = [f.name for f in dataclasses.fields(PART_TYPES[part])  # the lengths: floats in m
+             if isinstance(f.default, float) and not f.name.endswith("_deg")]
     return [(f"geometry.params.{n}", v) for n in names for v in HUGE_AND_SUBNORMAL]
 
 
@@ -580,15 +583,16 @@ def mutated_flexbody(good, member, kind, folder):
 
 def file_problem(good, member, kind, folder, command="check"):
     """What is wrong with crankmodal's answer to a flexbody with one member mutated: through
-    the API (load_flexbody returns, or raises FlexbodyFileError naming a member) and the CLI
+    the API (load_flexbody returns, or raises a CrankmodalError naming the file) and the CLI
     (exit 0, or 2 with one line naming the scene key and the file)."""
-    from crankmodal.reduction.io import FlexbodyFileError, load_flexbody
+    from crankmodal.errors import CrankmodalError
+    from crankmodal.reduction.io import load_flexbody
 
     folder.mkdir(parents=True, exist_ok=True)
     scene, npz = mutated_flexbody(good, member, kind, folder)
     try:
         load_flexbody(npz)
-    except FlexbodyFileError as exc:
+    except CrankmodalError as exc:  # a FlexbodyFileError naming file and member
         if str(npz) not in str(exc):
             return f"API error does not name the file: {exc}"
     except Exception as exc:  # noqa: BLE001 - any other exception is the defect reported
