@@ -327,7 +327,25 @@ def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
     from the big to the small end; its length checked against the mechanism's ``rod_length``
     (m, ±1 %). ``spec`` as for :func:`crank_body` (:func:`body_spec`: ``n_modes`` /
     ``cutoff_hz``, ``damping_ratio`` default 0.02); ``z`` the rod's row, m. A bad argument
-    raises ParameterError naming it (``spec.damping_ratio``, ``rod_length``, ``source``)."""
+    raises ParameterError naming it (``spec.damping_ratio``, ``rod_length``, ``source``).
+
+    Parameters
+    ----------
+    source : str, Path or reduced body
+        A ``crankmodal-flexbody`` .npz of a rod, or the body :func:`load_flexbody` read.
+    spec : dict, optional
+        ``n_modes`` or ``cutoff_hz`` (Hz), ``damping_ratio``.
+    rod_length : float, optional
+        The mechanism's rod length (m), checked against the bores' distance.
+    name : str
+        The body's name (``rod_1`` ...).
+    z : float
+        The rod's row along the crankpin, m.
+
+    Returns
+    -------
+    FlexibleBody
+    """
     from .. import arguments as arg
     from .flexible import planar_body
 
@@ -538,6 +556,15 @@ def rigid_twin(body):
     journal's force is still defined; any other body becomes a :class:`~.bodies.RigidBody`
     (the fast path). Rotary inertias attached to its interfaces
     (:meth:`~.flexible.FlexibleBody.attach_inertia`) are kept: frozen, they add to ``J₀``.
+
+    Parameters
+    ----------
+    body : FlexibleBody
+
+    Returns
+    -------
+    RigidBody or FlexibleBody
+        The twin, with the same name, mass (kg), polar inertia (kg m²) and frames.
     """
     from .bodies import RigidBody
 

@@ -35,6 +35,26 @@ class Cylinder:
     ``rod_com`` is the distance of the rod's centre of mass from the big-end centre; ``offset``
     the piston-pin offset across the cylinder axis (positive towards +90 deg from the axis);
     ``z`` the axial row position along the crankpin (for 3D moments).
+
+    Attributes
+    ----------
+    axis_angle : float
+        The cylinder axis from +x, counter-clockwise, rad.
+    rod_length : float
+        Big-end to small-end centre, m.
+    rod_mass, piston_mass : float
+        kg (the piston with its pin and rings).
+    rod_inertia : float
+        The rod's polar moment of inertia about its centre of mass, kg m².
+    rod_com : float
+        m, from the big-end centre.
+    offset, z : float
+        m.
+    gas_force : callable or None
+        ``gas_force(angle)``: the gas force on the piston (N) against the crank angle from this
+        cylinder's top dead centre (rad).
+    ring_friction : float
+        Piston-ring friction force, N (>= 0).
     """
 
     axis_angle: float
@@ -113,7 +133,30 @@ class Cylinder:
 
 @dataclass
 class Mechanism:
-    """A built mechanism: systems, initial state and what the outputs need to know."""
+    """A built mechanism: systems, initial state and what the outputs need to know.
+
+    Made by :func:`crank_train` or :func:`four_bar`; :func:`simulate` integrates it.
+
+    Attributes
+    ----------
+    kind : str
+        The ``kind`` given to :func:`crank_train` (``slider_crank``, ``four_star``), or
+        ``four_bar``.
+    system, ideal : Multibody
+        The mechanism, and its twin with every clearance joint an ideal pin.
+    q0, qd0 : ndarray
+        The initial coordinates and velocities (m, rad; m/s, rad/s).
+    crank : body
+        The crank.
+    pistons, axes : list
+        The pistons and their cylinder axes.
+    revolution_hz : float
+        Crank revolutions per second.
+    main_joint, main_joints, rows_z
+        The main bearing's joint name(s) and the rows' axial positions (m).
+    start, start_info
+        How the initial state was found (``quasi_static`` or ``undeformed``) and its record.
+    """
 
     kind: str
     system: Multibody

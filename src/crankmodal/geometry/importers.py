@@ -51,7 +51,25 @@ def region_specs(defs: list) -> list:
 
 
 def import_cad(path, specs: list, settings: MeshSettings) -> Part:
-    """Mesh a STEP/IGES/BREP file (lengths converted to metres) and name its regions."""
+    """Mesh a STEP/IGES/BREP file (lengths converted to metres) and name its regions.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CAD file (its units converted to m by OpenCASCADE).
+    specs : list of RegionSpec
+        Named regions to make: ``crankmodal.geometry.regions.RegionSpec`` of kind ``cylinder_axis``
+        (the boundary facets on a cylinder: ``axis_xy`` a point and direction, ``radius``, m) or
+        ``box`` (``z_range`` the six bounds, m); the scene's ``geometry.regions`` tables become
+        these.
+    settings : MeshSettings
+        Element size (m), order and refinement.
+
+    Returns
+    -------
+    Part
+        The meshed part with its regions, CAD mass properties and mesh-quality report.
+    """
     from .build import mesh_tagged
     from .massprops import cad_mass_properties, compare, mesh_mass_properties
     from .session import gmsh_session, quiet_stdout
@@ -172,6 +190,22 @@ def import_mesh(path, specs: list = ()) -> Part:
 
     Names come from gmsh physical groups of triangles, cell sets of triangles, and point sets
     (boundary facets whose corners all belong to the set). Volume cell sets are ignored.
+
+    Parameters
+    ----------
+    path : str or Path
+        Any meshio volume mesh with tetra or tetra10 cells (.msh, .vtu, .inp, ...), in m. The
+        file is untrusted: non-finite points, cells naming missing points, no tetrahedra and
+        inverted elements are refused.
+    specs : list of RegionSpec
+        Further regions to make: ``crankmodal.geometry.regions.RegionSpec`` of kind ``cylinder_axis``
+        (the boundary facets on a cylinder: ``axis_xy`` a point and direction, ``radius``, m) or
+        ``box`` (``z_range`` the six bounds, m); the scene's ``geometry.regions`` tables become
+        these.
+
+    Returns
+    -------
+    Part
     """
     import meshio
 
