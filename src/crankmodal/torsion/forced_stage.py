@@ -340,10 +340,10 @@ def run(f: dict, ctx, chain) -> dict:
     margins = separation_margins(natural_hz, ex.orders, rel, ops, f["speed_band"], f["significance"])
 
     secs = f["section_objects"]
-    if secs is not None:
-        kt_over_z = np.array([s.stress_concentration / s.section_modulus for s in secs])
-        stress = res.section_torque_nm * kt_over_z
-        order_stress = np.abs(res.section_torque) * kt_over_z
+    if secs is not None:  # each section's own K_t T / Z_p
+        stress = np.column_stack([s.stress(res.section_torque_nm[:, i]) for i, s in enumerate(secs)])
+        order_stress = np.stack([s.stress(np.abs(res.section_torque[..., i])) for i, s in enumerate(secs)],
+                                axis=-1)
     else:  # no section data: the check runs on torque (N m) and names the worst section by torque
         stress = res.section_torque_nm
         order_stress = np.abs(res.section_torque)

@@ -39,7 +39,9 @@ def polar_section_modulus(diameter: float, bore: float = 0.0) -> float:
         raise ParameterError("diameter", f"must be > 0 (m), got {diameter!r}")
     if not (math.isfinite(bore) and 0 <= bore < diameter):
         raise ParameterError("bore", f"must be >= 0 and < diameter ({diameter:g} m), got {bore!r}")
-    return math.pi * (diameter**4 - bore**4) / (16.0 * diameter)
+    from .equivalent_length import polar_moment
+
+    return polar_moment(diameter, bore) / (diameter / 2.0)  # J_p / r
 
 
 @dataclass(frozen=True)
