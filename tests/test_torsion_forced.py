@@ -190,3 +190,51 @@ def test_api_arguments_of_the_wrong_type_name_the_argument(call, name):
     ex = rotor_excitation(4, 6.0, 2, harmonics=[{"rotor": 0, "order": 1.0, "amplitude": 1.0}])
     with pytest.raises(ParameterError, match=name):
         call(train, ex)
+
+
+def test_margins_count_only_significant_orders_and_match_hand_critical_speeds():
+    from crankmodal.torsion.verdict import modal_excitation, separation_margins
+
+    I, k = 0.5, 2.0e5
+    train = damped_train(TorsionalChain([I, I], [k]))
+    hz, shapes = train.natural_frequencies()
+    f_n = math.sqrt(2 * k / I) / (2 * math.pi)  # equal rotors: closed form
+    assert hz[0] == pytest.approx(f_n, rel=1e-12)
+    # order 2 on both rotors in phase: the phase-vector sum on the shape [1, -1] is zero;
+    # order 3 on rotor 1 only
+    ex = rotor_excitation(2, 3.0, 1, harmonics=[{"rotor": 0, "order": 2.0, "amplitude": 50.0},
+                                                {"rotor": 1, "order": 2.0, "amplitude": 50.0},
+                                                {"rotor": 0, "order": 3.0, "amplitude": 20.0}])
+    n2, n3 = 60 * f_n / 2, 60 * f_n / 3  # hand critical speeds
+    ops = [1.03 * n2, 0.95 * n3]
+    rel = np.array([modal_excitation(shapes, ex.at([n * math.pi / 30])[0]) for n in ops])
+    rel /= rel.max(axis=2, keepdims=True)
+    out = separation_margins(hz, ex.orders, rel, ops, 0.10, 0.10)
+    # order 2 is inside the first band but cancels; order 3 is inside the second band
+    assert [(v["order"], v["mode"]) for v in out["violations"]] == [(3.0, 1)]
+    assert out["violations"][0]["margin"] == pytest.approx(n3 / ops[1] - 1, rel=1e-12)
+    assert out["closest"][0]["order"] == 3.0 and not out["passes"]
+
+
+def test_stress_check_worst_speed_and_stress_match_the_two_rotor_closed_form():
+    from crankmodal.torsion.stress import Allowable, Section
+    from crankmodal.torsion.verdict import stress_check
+
+    zeta = 0.03
+    wn = math.sqrt(K * (I1 + I2) / (I1 * I2))
+    c = 2 * zeta * wn * I1 * I2 / (I1 + I2)
+    train = damped_train(TorsionalChain([I1, I2], [K]), modal_damping=zeta)
+    ex = rotor_excitation(2, 2.0, 1, harmonics=[{"rotor": 0, "order": 2.0, "amplitude": 80.0}])
+    rpm = np.arange(100.0, 3000.0, 1.0)
+    res = steady_state(train, ex, rpm)
+    sec = Section.round(0.03, 0.01, 1.8)
+    stress = np.column_stack([sec.stress(res.section_torque_nm[:, 0])])
+    chk = stress_check(rpm, stress, np.abs(res.section_torque)[..., :1] * 1.8 / sec.section_modulus,
+                       ex.orders, Allowable(2.0e8).stress, ["shaft"])
+    w = 2 * rpm * math.pi / 30
+    t1, t2 = two_rotor_closed_form(w, 80.0, c)
+    tau = 1.8 * np.abs(K * (t1 - t2)) * 16 * 0.03 / (math.pi * (0.03**4 - 0.01**4))  # K_t T r / J_p
+    assert chk["speed_rpm"] == rpm[np.argmax(tau)]
+    assert chk["stress_pa"] == pytest.approx(tau.max(), rel=1e-9)
+    assert chk["utilisation"] == pytest.approx(tau.max() / 1.0e8, rel=1e-9)
+    assert chk["dominant_order"] == 2.0 and chk["passes"] == (tau.max() <= 1.0e8)

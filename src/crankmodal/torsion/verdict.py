@@ -53,23 +53,26 @@ def separation_margins(natural_hz, orders, relative_excitation, operating_rpm, b
         margin, relative excitation), ``closest`` (the significant critical speed nearest each
         operating speed, with its margin), ``band``, ``significance``.
     """
+    from .critical_speeds import CriticalSpeeds
+
+    orders = np.asarray(orders, float)
+    crit = CriticalSpeeds(np.asarray(natural_hz, float), orders, (0.0, np.inf)).all_criticals()
     violations, closest = [], []
     for o, n_op in enumerate(operating_rpm):
         best = None
-        for m, f in enumerate(natural_hz):
-            for j, q in enumerate(orders):
-                rel = float(relative_excitation[o, m, j])
-                if rel < significance:
-                    continue
-                n_c = 60.0 * f / q
-                margin = (n_c - n_op) / n_op
-                row = {"operating_speed_rpm": float(n_op), "mode": m + 1, "natural_hz": float(f),
-                       "order": float(q), "critical_speed_rpm": float(n_c), "margin": float(margin),
-                       "relative_excitation": rel}
-                if abs(margin) < band:
-                    violations.append(row)
-                if best is None or abs(margin) < abs(best["margin"]):
-                    best = row
+        for c in crit:
+            j = int(np.argmin(np.abs(orders - c["order"])))
+            rel = float(relative_excitation[o, c["mode"] - 1, j])
+            if rel < significance:
+                continue
+            margin = (c["speed_rpm"] - n_op) / n_op
+            row = {"operating_speed_rpm": float(n_op), "mode": c["mode"], "natural_hz": c["natural_hz"],
+                   "order": c["order"], "critical_speed_rpm": c["speed_rpm"], "margin": float(margin),
+                   "relative_excitation": rel}
+            if abs(margin) < band:
+                violations.append(row)
+            if best is None or abs(margin) < abs(best["margin"]):
+                best = row
         closest.append(best)
     return {"band": band, "significance": significance, "violations": violations,
             "closest": closest, "passes": not violations}
