@@ -178,3 +178,24 @@ def test_bad_arrangement_and_pressure_table_are_refused_naming_the_key():
         PressureTable(np.radians([0, 100, 720]), [1e5, 2e5, 1.5e5], 2)
     with pytest.raises(ParameterError, match="throw_rotors"):
         rotor_excitation(4, 4.0, 2, cylinder_efforts(m), throw_rotors=[0, 1])
+
+
+def test_v_twin_on_one_pin_sums_both_cylinders_on_its_throw():
+    r = 0.04
+    cyls = (Cylinder(math.radians(-45.0), 0.0, 0.0, piston_mass=0.8, bore=0.09),
+            Cylinder(math.radians(45.0), 0.0, 0.0, piston_mass=0.8, bore=0.09))
+    m = Machine("v", r, _rod(0.15, 0.5), 3000.0, cyls)
+    arr = arrangement_of_machine(m, cylinder_throws=[0, 0])
+    assert arr.n_throws == 1
+    eff = cylinder_efforts(m, arr)
+    ex = rotor_excitation(2, 4.0, 1, eff, throw_rotors=[0])
+    _, h = eff.cylinder_harmonics(4)
+    # cylinder 2 is cylinder 1 delayed by its 90 deg bank: c_q,2 = c_q,1 exp(-i q 90 deg)
+    q = np.arange(1, 5)
+    np.testing.assert_allclose(h[:, 1], h[:, 0] * np.exp(-1j * q * math.pi / 2), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(ex.inertia_unit[:, 0], h.sum(axis=1), rtol=1e-12)
+    assert not np.any(ex.inertia_unit[:, 1])
+    # two cylinders on one throw must share its angle
+    bad = Machine("v", r, _rod(0.15, 0.5), 3000.0, (cyls[0], Cylinder(0.0, 0.0, 1.0, 0.8, 0.09)))
+    with pytest.raises(ParameterError, match=r"cylinder_throws\[1\]"):
+        arrangement_of_machine(bad, cylinder_throws=[0, 0])

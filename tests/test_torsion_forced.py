@@ -238,3 +238,16 @@ def test_stress_check_worst_speed_and_stress_match_the_two_rotor_closed_form():
     assert chk["stress_pa"] == pytest.approx(tau.max(), rel=1e-9)
     assert chk["utilisation"] == pytest.approx(tau.max() / 1.0e8, rel=1e-9)
     assert chk["dominant_order"] == 2.0 and chk["passes"] == (tau.max() <= 1.0e8)
+
+
+def test_tuned_rubber_damper_ring_matches_closed_form_with_complex_stiffness():
+    J, k, Jd, kd, eta = 1.0, 4.0e5, 0.1, 3.5e4, 0.25
+    chain = TorsionalChain([J], [k], fixed_end=True)
+    train = damped_train(chain, modal_damping=0.0, dampers=[Damper(0, Jd, stiffness=kd, loss_factor=eta)])
+    w = np.array([300.0, 590.0, 640.0, 900.0])
+    X = harmonic_response(train, w, np.ones((4, 1)) * 10.0)
+    z = kd * (1 + 1j * eta)  # rubber: complex stiffness
+    ring = z / (z - Jd * w**2)
+    hub = 10.0 / (k - J * w**2 + z * (1 - ring))
+    np.testing.assert_allclose(X[:, 0], hub, rtol=1e-9)
+    np.testing.assert_allclose(X[:, 1], hub * ring, rtol=1e-9)
