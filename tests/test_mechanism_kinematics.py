@@ -83,13 +83,14 @@ def test_exact_displacement_closes_the_crank_rod_loop():
 
 
 @pytest.mark.parametrize("lam", [0.1, 0.25])
-def test_acceleration_harmonics_match_the_classical_series(lam):
+def test_acceleration_harmonics_match_the_classical_series(oracle, lam):
     # Oracle: the classical expansion of the piston acceleration (e.g. Den Hartog, Mechanical
     # Vibrations): A1 = 1, A2 = lam + lam^3/4 + 15 lam^5/128, A4 = -(lam^3/4 + 3 lam^5/16),
     # A6 = 9 lam^5/128, odd orders above 1 are zero. Truncation of the oracle: O(lam^7).
     A = acceleration_harmonics(lam, 6)
     tol = 2 * lam**7
     assert A[0] == pytest.approx(1.0, abs=1e-13)
+    oracle(stage="mechanism", quantity=f"piston acceleration, 2nd harmonic coefficient, lambda = {lam}", reference="classical series (Den Hartog)", tolerance=f"{tol:.1e} abs", measured=A[1], expected=lam + lam**3 / 4 + 15 * lam**5 / 128)
     assert A[1] == pytest.approx(lam + lam**3 / 4 + 15 * lam**5 / 128, abs=tol)
     assert A[3] == pytest.approx(-(lam**3 / 4 + 3 * lam**5 / 16), abs=tol)
     assert A[5] == pytest.approx(9 * lam**5 / 128, abs=tol)
