@@ -670,10 +670,16 @@ def api_calls():
                                             "max_elements": 5e6, "reason": "test"}),
         "reduced_bar": (reduced_bar, {"length": 0.075, "section": (0.05, 0.077), "spec": spec,
                                       "key": "coupler"}),
-        **{f"reduced_bar spec.{k}": ((lambda k: lambda **kw: reduced_bar(
-            0.075, (0.05, 0.077), {**spec, k: kw[k]}, "coupler"))(k), {k: v})
+        **{f"reduced_bar spec.{k}": (_spec_call(reduced_bar, spec, k), {k: v})
            for k, v in spec.items()},
     }
+
+
+def _spec_call(reduced_bar, spec, key):
+    """reduced_bar of the coupler with ``spec[key]`` given as the keyword ``key``."""
+    def call(**kw):
+        return reduced_bar(0.075, (0.05, 0.077), {**spec, key: kw[key]}, "coupler")
+    return call
 
 
 def test_api_arguments_of_every_type_raise_one_clear_error(flexbody_file, tmp_path, monkeypatch):

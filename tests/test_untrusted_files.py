@@ -23,13 +23,20 @@ import re
 import shutil
 import struct
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 from conftest import SCENES, run_in_process
 
-from crankmodal.errors import CrankmodalError, GeometryError, InputFileError, ModelWarning, \
-    ParameterError, ResourceError
+from crankmodal.errors import (
+    CrankmodalError,
+    GeometryError,
+    InputFileError,
+    ModelWarning,
+    ParameterError,
+    ResourceError,
+)
 
 SPEC = {"mesh_size": 0.025, "element_order": 1, "material": "steel", "fixed_interface_modes": 4}
 COUPLER = (0.075, (0.05, 0.077))  # the loom's coupler: pin distance, [width, thickness], m
@@ -70,7 +77,7 @@ def poke(name, index, value):
 def flip_in(member):
     """Flip one bit in the middle of ``member``'s array data (its CRC no longer matches)."""
     def damage(good, out):
-        data = bytearray(open(good, "rb").read())
+        data = bytearray(Path(good).read_bytes())
         with zipfile.ZipFile(good) as zf:
             info = zf.getinfo(f"{member}.npy")
         n, m = struct.unpack("<HH", data[info.header_offset + 26:info.header_offset + 30])
@@ -97,6 +104,14 @@ def huge_header(member):
     return damage
 
 
+def _npy(array) -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    np.save(buf, array)
+    return buf.getvalue()
+
+
 def _set(name, value):
     return lambda d: d.__setitem__(name, value)
 
@@ -104,9 +119,9 @@ def _set(name, value):
 #: kind -> (damage(good, out), the member the error names; "" for the file as a whole)
 DAMAGES = {
     "empty": (lambda g, o: o.write_bytes(b""), ""),
-    "truncated": (lambda g, o: o.write_bytes(open(g, "rb").read()[:5000]), ""),
+    "truncated": (lambda g, o: o.write_bytes(Path(g).read_bytes()[:5000]), ""),
     "not a zip": (lambda g, o: o.write_text("frequencies_hz = 12.0\n"), ""),
-    "a bare npy": (lambda g, o: np.save(open(o, "wb"), np.zeros(3)), ""),
+    "a bare npy": (lambda g, o: o.write_bytes(_npy(np.zeros(3))), ""),
     "bit-flipped I9": (flip_in("I9"), "I9"),
     "bit-flipped interface_map": (flip_in("interface_map"), "interface_map"),
     "8 TB declared": (huge_header("frequencies_hz"), "frequencies_hz"),
@@ -281,8 +296,8 @@ def test_run_with_a_damaged_cached_flexbody_rebuilds_it_with_one_warning(cli, tm
 
 
 def test_damaged_cached_part_is_rebuilt_with_a_warning(tmp_path, monkeypatch):
-    from crankmodal.geometry.cache import cache_dir, load_part, store_part
     from crankmodal.fem.testparts import bar
+    from crankmodal.geometry.cache import cache_dir, load_part, store_part
 
     monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path))
     store_part("k", bar(divisions=(2, 1, 1), order=1))
@@ -342,9 +357,9 @@ def test_length_limits_are_the_documented_ones():
     check_lengths("rod", replace(rod, shank_fillet=0.0, length=100.0))
     check_lengths("rod", replace(rod, shank_fillet=1e-3 * (1 + 1e-12)))  # 100 / 1e5
     check_lengths("rod", replace(ConrodParams(), shank_fillet=1e-6 * (1 + 1e-12), length=0.1))
-    for changed, name in ((dict(length=100.0 * (1 + 1e-12)), "rod.length"),
-                          (dict(shank_fillet=1e-6 * (1 - 1e-12)), "rod.shank_fillet"),
-                          (dict(length=100.0, shank_fillet=1e-3 * (1 - 1e-12)), "rod.shank_fillet")):
+    for changed, name in (({"length": 100.0 * (1 + 1e-12)}, "rod.length"),
+                          ({"shank_fillet": 1e-6 * (1 - 1e-12)}, "rod.shank_fillet"),
+                          ({"length": 100.0, "shank_fillet": 1e-3 * (1 - 1e-12)}, "rod.shank_fillet")):
         with pytest.raises(LengthError) as info:
             check_lengths("rod", replace(rod, **changed))
         assert info.value.argument == name
@@ -405,10 +420,10 @@ def test_check_refuses_a_bar_too_fine_or_too_small(assignment, key, tmp_path):
 
 
 @pytest.mark.parametrize("assignment, fragment", [
-    ("dynamics.flexible.crank.mesh_size=1e-300", "dynamics.flexible.crank.mesh_size: must be in "
-                                                 "[1e-06, 100] m"),
-    ("dynamics.flexible.crank.mesh_size=1e-4", "dynamics.flexible.crank.mesh_size = 0.0001 m: at "
-                                               "least 1.8e+09 tetrahedra"),
+    ("dynamics.flexible.crank.mesh_size=1e-300",
+     "dynamics.flexible.crank.mesh_size: must be in [1e-06, 100] m"),
+    ("dynamics.flexible.crank.mesh_size=1e-4",
+     "dynamics.flexible.crank.mesh_size = 0.0001 m: at least 1.8e+09 tetrahedra"),
 ])
 def test_check_refuses_a_machine_part_reduced_here_too_fine(assignment, fragment):
     """The part a [dynamics.flexible] crank or rod reduces is checked by `check` (it passed, and
@@ -429,7 +444,12 @@ def test_run_refuses_a_bar_too_fine_or_too_small(assignment, tmp_path):
 
 
 def test_subnormal_mesh_size_is_a_refusal_not_a_division_by_zero():
-    from crankmodal.geometry.mesh import MeshSettings, check_size, check_size_floor, estimate_elements
+    from crankmodal.geometry.mesh import (
+        MeshSettings,
+        check_size,
+        check_size_floor,
+        estimate_elements,
+    )
     from crankmodal.geometry.params import ConrodParams
 
     for size in (1e-300, 5e-324, 1e30):

@@ -9,8 +9,6 @@ or in the box).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from ..errors import GeometryError, InputFileError
@@ -70,11 +68,10 @@ def import_cad(path, specs: list, settings: MeshSettings) -> Part:
     Part
         The meshed part with its regions, CAD mass properties and mesh-quality report.
     """
+    from ..reduction.io import file_argument
     from .build import mesh_tagged
     from .massprops import cad_mass_properties, compare, mesh_mass_properties
     from .session import gmsh_session, quiet_stdout
-
-    from ..reduction.io import file_argument
 
     path = file_argument(path)
     if not path.is_file():
