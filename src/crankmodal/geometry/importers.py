@@ -9,6 +9,8 @@ or in the box).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from ..errors import GeometryError, InputFileError
@@ -68,12 +70,12 @@ def import_cad(path, specs: list, settings: MeshSettings) -> Part:
     Part
         The meshed part with its regions, CAD mass properties and mesh-quality report.
     """
-    from ..reduction.io import file_argument
+    from ..arguments import path as path_argument
     from .build import mesh_tagged
     from .massprops import cad_mass_properties, compare, mesh_mass_properties
     from .session import gmsh_session, quiet_stdout
 
-    path = file_argument(path)
+    path = Path(path_argument("path", path))
     if not path.is_file():
         raise InputFileError(f"geometry.file: file not found: {path}")
     with gmsh_session(f"import {path.name}", {"file": str(path)}) as gmsh:
@@ -206,9 +208,9 @@ def import_mesh(path, specs: list = ()) -> Part:
     """
     import meshio
 
-    from ..reduction.io import file_argument
+    from ..arguments import path as path_argument
 
-    path = file_argument(path)
+    path = Path(path_argument("path", path))
     if not path.is_file():
         raise InputFileError(f"geometry.file: file not found: {path}")
     try:

@@ -213,18 +213,6 @@ class _Members:
         return a
 
 
-def file_argument(path, name: str = "path") -> Path:
-    """``path`` as a Path, or a ParameterError naming ``name`` when it is no file name."""
-    import os
-
-    if not isinstance(path, (str, os.PathLike)) or not str(path):
-        from ..errors import ParameterError
-
-        raise ParameterError(name, f"must be a file name (str or path), got "
-                             f"{type(path).__name__} {path!r}"[:200])
-    return Path(path)
-
-
 def _kind(a: np.ndarray) -> str:
     return f"{a.dtype} of shape {a.shape}"
 
@@ -277,7 +265,9 @@ def load_flexbody(path) -> FlexibleBody:
         ``crankmodal-flexbody`` file of a known version, or a member that is missing, of the
         wrong kind or shape, non-finite, or out of its physical range.
     """
-    path = file_argument(path)
+    from ..arguments import path as path_argument
+
+    path = Path(path_argument("path", path))
     z = _open(path)
     with z:
         r = _Members(path, z)
