@@ -202,6 +202,14 @@ PROBES = [
      lambda m, b: cm.crank_model(cm.load_machine("multi_bearing_compressor")["torsion"]["throw"],
                                  {"diameter": 0.5, "thickness": 0.1}, 8e10, NAN), "density"),
     ("cylinder-from-machine-none", lambda m, b: cm.Cylinder.from_machine(None, None), "machine"),
+    # FE and reduction entry points
+    ("assemble-part-str", lambda m, b: cm.assemble("rod.step", cm.material("steel")), "part"),
+    ("solve-modes-model-str", lambda m, b: cm.solve_modes("model", 6), "model"),
+    ("mass-properties-model-none", lambda m, b: cm.mass_properties(None), "model"),
+    ("make-interfaces-part-str", lambda m, b: cm.make_interfaces("rod", []), "part"),
+    ("select-supports-part-none", lambda m, b: cm.select_supports(None, []), "part"),
+    ("save-flexbody-path-none", lambda m, b: cm.save_flexbody(None, b), "path"),
+    ("save-flexbody-body-dict", lambda m, b: cm.save_flexbody("x.npz", {}), "body"),
     # scenes
     ("load-scene-none", lambda m, b: cm.load_scene(None), "path"),
     ("scene-from-dict-str", lambda m, b: cm.scene_from_dict("torsion"), "data"),

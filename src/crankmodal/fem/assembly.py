@@ -195,6 +195,12 @@ def assemble(part, material, timings: dict | None = None) -> FEModel:
     -------
     FEModel
     """
+    from ..arguments import instance
+    from ..part import Part
+    from .materials import Material
+
+    instance("part", part, Part, "a Part (build_part, import_mesh)")
+    instance("material", material, Material, "a Material (material(name))")
     import time
 
     from skfem import CellBasis
@@ -322,6 +328,9 @@ def mass_properties(model: FEModel) -> dict:
     >>> print(f"{mp['mass']:.4f} kg")
     1.4130 kg
     """
+    from ..arguments import instance
+
+    instance("model", model, FEModel, "an FEModel (assemble)")
     mass, c = mass_and_centre(model)
     Rc = rigid_body_modes(model.points, c)[:, 3:]
     inertia = Rc.T @ (model.M @ Rc)

@@ -236,6 +236,10 @@ def solve_modes(model: FEModel, n_modes: int = 12, supports: list[Support] = (),
     >>> bool(abs(modes.frequencies_hz[0] / eb - 1) < 0.02)
     True
     """
+    from ..arguments import instance
+    from .assembly import FEModel
+
+    instance("model", model, FEModel, "an FEModel (assemble)")
     if n_modes < 1:
         raise ParameterError("n_modes", f"must be >= 1, got {n_modes}")
     if shift is not None and not float(shift) < 0:

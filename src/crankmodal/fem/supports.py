@@ -288,6 +288,10 @@ def select_supports(part, specs, label: str = "supports") -> list[Support]:
         malformed table, or a Support whose nodes are not points of the part; the argument is
         ``supports[i]...``.
     """
+    from ..arguments import instance
+    from ..part import Part
+
+    instance("part", part, Part, "a Part (build_part, import_mesh)")
     specs = check_specs(specs)
     n_points = len(part.mesh.points)
     out = []

@@ -163,6 +163,10 @@ def make_interfaces(part, specs, cells: np.ndarray | None = None) -> list[Interf
         region, no facets, or wholly inside an earlier interface); ``i`` indexes ``specs``. The
         ``[reduction]`` stage re-raises it under the scene key ``reduction.interfaces[i]...``.
     """
+    from ..arguments import instance
+    from ..part import Part
+
+    instance("part", part, Part, "a Part (build_part, import_mesh)")
     points = np.asarray(part.mesh.points, float)[:, :3]
     if cells is None:
         cells = np.asarray(part.mesh.cells[0].data)

@@ -66,6 +66,11 @@ _ARRAYS = ("frequencies_hz", "stiffness", "mass", "rigid", "interface_centres", 
 
 def save_flexbody(path, body: FlexibleBody) -> Path:
     """Write ``body`` to ``path`` (``.npz``, uncompressed); returns the path."""
+    from ..arguments import instance
+    from ..arguments import path as path_argument
+
+    path_argument("path", path)
+    instance("body", body, FlexibleBody, "a reduced body (reduce_body, load_flexbody)")
     path = Path(path)
     data = {k: np.asarray(getattr(body, k)) for k in _ARRAYS}
     data.update({
