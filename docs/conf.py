@@ -18,7 +18,7 @@ DOCS = Path(__file__).resolve().parent
 sys.path.insert(0, str(DOCS / "_ext"))
 sys.path.insert(0, str(DOCS.parent / "src"))
 
-import crankmodal  # noqa: E402
+import crankmodal
 
 project = "crankmodal"
 author = "the crankmodal authors"

@@ -91,13 +91,15 @@ _ORACLE_TESTS: set[str] = set()
 
 
 def _oracle_number(name, x):
+    import math
+
     if x is None:
         return None
     try:
         v = float(x)
     except (TypeError, ValueError):
         raise TypeError(f"oracle {name} must be a number, got {x!r}") from None
-    if v != v or v in (float("inf"), float("-inf")):
+    if not math.isfinite(v):
         raise ValueError(f"oracle {name} must be finite, got {v!r}")
     return v
 

@@ -15,12 +15,11 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 import pytest
-
 from conftest import ORACLE_STAGES, REPO
 
 DOCS = REPO / "docs"
 sys.path.insert(0, str(DOCS / "_ext"))
-import crankmodal_docs  # noqa: E402
+import crankmodal_docs
 
 #: modules whose docstring Examples are executed (the main entry points)
 DOCTEST_MODULES = (
@@ -109,9 +108,9 @@ def test_site_builds_and_every_internal_link_and_anchor_resolves(site):
             if not target.exists():
                 broken.append(f"{page.relative_to(site)}: {link}")
                 continue
-            if parts.fragment and target.suffix == ".html" and target in parsed:
-                if unquote(parts.fragment) not in parsed[target].ids:
-                    broken.append(f"{page.relative_to(site)}: {link} (no such anchor)")
+            if (parts.fragment and target.suffix == ".html" and target in parsed
+                    and unquote(parts.fragment) not in parsed[target].ids):
+                broken.append(f"{page.relative_to(site)}: {link} (no such anchor)")
     assert not broken, "\n".join(broken[:40])
 
 
@@ -203,7 +202,7 @@ def test_readme_is_short_and_links_only_to_files_that_exist():
     text = (REPO / "README.md").read_text(encoding="utf-8")
     assert len(text.splitlines()) <= 200
     ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
-    test_command = re.search(r"^python3 -m venv .*pytest -q$", text, re.M).group(0)
+    test_command = re.search(r"^python3 -m venv .*pytest -q$", text, re.MULTILINE).group(0)
     assert test_command in ci
     assert "python3 -m venv .venv && .venv/bin/pip install -q -e . && .venv/bin/crankmodal demo" \
         in text
@@ -212,7 +211,7 @@ def test_readme_is_short_and_links_only_to_files_that_exist():
             continue
         assert (REPO / link).exists(), link
     # no leftover editing text, and no statement that the reduction does not feed the dynamics
-    assert '"' not in "".join(re.findall(r"^#+ .*$", text, re.M))
+    assert '"' not in "".join(re.findall(r"^#+ .*$", text, re.MULTILINE))
     assert "not yet used" not in text
 
 

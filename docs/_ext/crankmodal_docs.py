@@ -21,7 +21,6 @@ from __future__ import annotations
 import importlib
 import json
 import math
-import shutil
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parents[1]
@@ -156,14 +155,15 @@ def scene_markdown() -> str:
     lines = [
         "# Scene reference",
         "",
-        "Generated from the stages' schemas (`SCHEMA` dicts of `crankmodal.schema.Field`) each "
-        "time the site is built: what is listed here is exactly what `crankmodal check` "
-        "accepts. Units are SI (m, kg, s, N, Pa, rad) unless the key's name or meaning says "
-        "otherwise (`speed_rpm`, `*_deg`, `*_hz`). A `[[name]]` table is an array of tables. "
-        "The sweep file (`SWEEP.toml`) is described in " + _guide_link("sweeps.md", "sweeps") + ".",
+        ("Generated from the stages' schemas (`SCHEMA` dicts of `crankmodal.schema.Field`) "
+         "each time the site is built: what is listed here is exactly what `crankmodal check` "
+         "accepts. Units are SI (m, kg, s, N, Pa, rad) unless the key's name or meaning says "
+         "otherwise (`speed_rpm`, `*_deg`, `*_hz`). A `[[name]]` table is an array of tables. "
+         "The sweep file (`SWEEP.toml`) is described in "
+         + _guide_link("sweeps.md", "sweeps") + "."),
         "",
-        "A scene file holds `name = \"...\"` and one section per stage to run; a section may "
-        "take `machine = \"NAME\"` to pull its defaults from `geometry/NAME.toml`.",
+        ("A scene file holds `name = \"...\"` and one section per stage to run; a section may "
+         "take `machine = \"NAME\"` to pull its defaults from `geometry/NAME.toml`."),
         "",
         "## Top-level keys",
         "",
@@ -171,8 +171,8 @@ def scene_markdown() -> str:
         "|---|---|---|---|",
     ]
     from crankmodal.scene import TOP_LEVEL_KEYS
-    meaning = {"name": ("the file's stem", "the scene's name; the default output folder is "
-                        "`out/<name>/`"),
+    meaning = {"name": ("the file's stem",
+                        "the scene's name; the default output folder is `out/<name>/`"),
                "description": ('`""`', "free text about the scene")}
     for key in TOP_LEVEL_KEYS:
         default, text = meaning.get(key, ("-", ""))
@@ -180,8 +180,7 @@ def scene_markdown() -> str:
     lines.append("")
     for table, what, schema in schema_tables():
         what = what.replace("[reports](../guide/reports.md)", _guide_link("reports.md", "reports"))
-        title = f"`[{table}]`" if not table.startswith("[") else f"`[{table}]`"
-        lines += [f"## {title}", "", what, "",
+        lines += [f"## `[{table}]`", "", what, "",
                   "| key | type | default | allowed | meaning |",
                   "|---|---|---|---|---|"]
         for key, f in schema.items():
@@ -217,14 +216,15 @@ def validation_markdown(rows: list[dict]) -> str:
     lines = [
         "# Validation",
         "",
-        "Every number below was written by the test that checks it: the tests call the "
-        "`oracle` fixture (`tests/conftest.py`) with the quantity, its independent reference "
-        "(closed form, published table, peer code, second formulation), the tolerance the test "
-        "asserts and the value it measured. Running the suite with "
-        "`CRANKMODAL_ORACLES=docs/validation/oracles.json` rewrites "
-        "`docs/validation/oracles.json`, from which this page is generated; nothing here is "
-        "typed by hand. The relative error is |measured - expected| / |expected|; where the "
-        "test checks a bound instead of a value, the expected column is empty.",
+        ("Every number below was written by the test that checks it: the tests call the "
+         "`oracle` fixture (`tests/conftest.py`) with the quantity, its independent reference "
+         "(closed form, published table, peer code, second formulation), the tolerance the test "
+         "asserts and the value it measured. Running the suite with "
+         "`CRANKMODAL_ORACLES=docs/validation/oracles.json` rewrites "
+         "`docs/validation/oracles.json`, from which this page is generated; nothing here is "
+         "typed by hand. The relative error is |measured - expected| / |expected|; where the "
+         "test checks a bound (no expected value) or a difference against zero, it is `-` and "
+         "the measured column is the value or the difference itself."),
         "",
     ]
     for stage in stages:
@@ -292,11 +292,11 @@ def api_markdown() -> str:
         else:
             other.append(name)
     lines = ["# API reference", "",
-             "Every public name of `crankmodal` (the names in `crankmodal.__all__`, generated "
-             "from it at build time; `import crankmodal` is cheap and each name is imported from "
-             "its home module on first use). Units are SI (m, kg, s, N, Pa, rad; Hz where a name "
-             "says so). `crankmodal.__version__` is the installed version. Worked examples are in "
-             "the [Python API](../guide/python_api.md) guide.", ""]
+             ("Every public name of `crankmodal` (the names in `crankmodal.__all__`, generated "
+              "from it at build time; `import crankmodal` is cheap and each name is imported "
+              "from its home module on first use). Units are SI (m, kg, s, N, Pa, rad; Hz where "
+              "a name says so). `crankmodal.__version__` is the installed version. Worked "
+              "examples are in the [Python API](../guide/python_api.md) guide."), ""]
     for title, text, _ in API_GROUPS + [("Other", "", ())]:
         members = groups.get(title, other if title == "Other" else [])
         if not members:
