@@ -1,8 +1,9 @@
 """The compiled right-hand side (crankmodal.dynamics.compiled) against the Python path.
 
 Oracle: the generic Python evaluation of the same system (``Multibody(compiled=False)``), state
-by state for every normal and friction law, and a whole smooth run (ideal joints: no impacts,
-so no chaotic amplification of round-off) sample by sample. Runs with impacts are not compared
+by state for every normal and friction law and for round, worn and lubricated (short film)
+bores, and whole smooth runs (ideal joints; a journal floating on its film: no impacts, so no
+chaotic amplification of round-off) sample by sample. Runs with impacts are not compared
 sample by sample: a 1e-9 change of rtol alone moves their impact sequence (see
 benchmarks/README.md); the closed-form impact tests of test_dynamics_contact run on the compiled
 path."""
