@@ -309,7 +309,7 @@ def test_johnson_cylinder_slider_crank_penetrates_micrometres_and_soft_impact_is
         res = run(scene_from_dict(soft, name="s"), tmp_path / "s", figures=False)["dynamics"]
     texts = [t for t in res["warnings"] if "penetrates" in t]
     assert len(texts) == 1
-    assert "'big_end_1'" in texts[0] and "0.0001 m clearance" in texts[0]
+    assert "'big_end_1'" in texts[0] and "100 µm clearance" in texts[0]  # 1e-4 m
     assert "dynamics.contact.stiffness (now 1e+09)" in texts[0] and "johnson_cylinder" in texts[0]
 
 

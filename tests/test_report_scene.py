@@ -241,3 +241,15 @@ def test_the_drive_torques_sign_is_stated_and_holds_in_the_run(scene_report):
     text = htmlmod.unescape(sec)
     assert "the drive torque is the torque the drive applies to the crank about +z" in text
     assert "its driving torque is negative while the power is positive" in text
+
+
+def test_the_whole_report_text_prints_no_exponent_notation(scene_report):
+    """Issue 25 #15 across every section, the stages' own summaries included (the dynamics
+    summary's energy balance read 2.0e-06 and its spread 1.599e+04-3.456e+04 N)."""
+    out, _ = scene_report
+    page = re.sub(r"<img [^>]*>", "", (out / "report.html").read_text())
+    text = htmlmod.unescape(re.sub(r"<[^>]+>", " ", page))
+    # a scene key's value echoed for the user to edit keeps the form one types in TOML
+    text = re.sub(r"\(now [^)]*\)", "", text)
+    assert not re.findall(r"\S*\d[eE][+-]?\d+\S*", text)
+    assert not re.search(r"\d-\d[\d.]* ?[kMGmµ]?(N|Hz|rpm)\b", text)

@@ -180,8 +180,12 @@ def run(params: dict, ctx) -> dict:
 
         for text in truncation_warnings(p, bodies):
             warn(text, into=early_warnings)
-    for text in timescales.check_budget(scales, t_end, settings.method, settings.max_rhs_evals):
-        warn(text, into=early_warnings)
+    from ..errors import scene_keys
+    from .budget import check as check_budget
+
+    with scene_keys("dynamics"):  # refuse what cannot finish (contact.damping: ... -> dynamics.)
+        for text in check_budget(mech, t_end, settings)[1]:
+            warn(text, into=early_warnings)
     start_info = None
     mech.start = p["flexible"]["start"]  # simulate() leaves an "undeformed" start as built
     if bodies is not None and p["flexible"]["start"] == "quasi_static":
@@ -370,7 +374,7 @@ def run(params: dict, ctx) -> dict:
         from ..report.quantity import quantity_range  # 15.99–34.56 kN, not 1.599e+04-3.456e+04
 
         e = res["headline"]["main_bearing_per_rev_peak_n"]
-        res["summary"] += (f"; the {p['ensemble']} trajectories (started 1e-12 apart) range "
+        res["summary"] += (f"; the {p['ensemble']} trajectories (started 10⁻¹² apart) range "
                            f"{quantity_range(e['min'], e['max'], 'N')} in that peak")
     if bodies is not None:
         names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in res["flexible"]["bodies"].items())

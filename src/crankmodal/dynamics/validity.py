@@ -44,12 +44,15 @@ def penetration_warning(cj, depth: float, force: float, E: float = 2.1e11,
     ratio = depth / approach if approach > 0.0 else 0.0  # no force: the clearance alone
     if of_clearance <= CLEARANCE_FRACTION and ratio <= APPROACH_FACTOR:
         return None
-    K = cj.law_params.get("stiffness", float("nan"))
-    return (f"dynamics: joint {cj.name!r} penetrates {depth:.3g} m, {100 * of_clearance:.0f} % "
-            f"of its {cj.clearance:.3g} m clearance (warning above "
-            f"{100 * CLEARANCE_FRACTION:.0f} %) and {ratio:.2g} times the elastic approach of "
-            f"journal and bore under its peak contact force {force:.3g} N ({approach:.2g} m, "
-            f"Johnson's conformal cylinders, L = {L:.3g} m; warning above "
+    from ..report.quantity import number, quantity  # 92.3 µm, not 9.23e-05 m (issue 25 #15)
+
+    K = cj.law_params.get("stiffness", float("nan"))  # echoed as a scene value is typed
+    return (f"dynamics: joint {cj.name!r} penetrates {quantity(depth, 'm', 3)}, "
+            f"{100 * of_clearance:.0f} % of its {quantity(cj.clearance, 'm', 3)} clearance "
+            f"(warning above {100 * CLEARANCE_FRACTION:.0f} %) and {number(ratio, 2)} times the "
+            f"elastic approach of journal and bore under its peak contact force "
+            f"{quantity(force, 'N', 3)} ({quantity(approach, 'm', 2)}, Johnson's conformal "
+            f"cylinders, L = {quantity(L, 'm', 3)}; warning above "
             f"{APPROACH_FACTOR:g} times): the contact law ({cj.law}) is far outside its "
             f"validity; raise dynamics.contact.stiffness (now {K:.3g}) or use "
             f"dynamics.contact.law = 'johnson_cylinder'")
