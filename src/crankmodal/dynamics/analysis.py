@@ -130,7 +130,9 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
     ------
     ParameterError
         An argument out of its range, naming it (``output_step: 1e-12 s makes 1e+10 output
-        samples ...``).
+        samples ...``); or a run that cannot finish within ``settings.max_rhs_evals``, estimated
+        before it starts (:func:`~.budget.check`), naming the key that limits the step
+        (``contact.damping: ...``).
     NumericalError
         Solver failure, or an energy balance that does not close, or a penetration so deep the
         contact law is meaningless (the message names the parameter to change).
@@ -140,6 +142,12 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
     sysm = mech.ideal if ideal else mech.system
     check_output(sysm, t_end, output_step)
     settings = resolved(settings, mech)
+    if not ideal:  # refuse what cannot finish within max_rhs_evals, before it runs (.budget)
+        from ..errors import warn
+        from .budget import check as check_budget
+
+        for text in check_budget(mech, t_end, settings)[1]:
+            warn(text)
     if (start or mech.start) == "quasi_static" and mech.start_info is None and mech.as_built():
         mech.start_quasi_static()
     for cj in sysm.clearances:

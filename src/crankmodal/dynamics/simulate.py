@@ -232,6 +232,13 @@ def _stiffness_advice(sysm, settings: SolverSettings | None = None) -> str:
             f"contact.stiffness, use solver.method = {other}, or raise solver.max_rhs_evals")
 
 
+def _per_step(settings) -> float:
+    """Right-hand-side evaluations per step of ``settings.method`` (1 for the implicit ones)."""
+    from .timescales import EVALS_PER_STEP
+
+    return float(EVALS_PER_STEP.get(settings.method, 1))
+
+
 def _progress_rhs(rhs, pbar):
     """``rhs`` that advances ``pbar`` to the simulated time reached, at most every 0.1 s of
     wall time (one clock read per evaluation)."""
@@ -320,6 +327,9 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
 
     # a disabled bar (not a terminal, --quiet) leaves the right-hand side untouched
     fun = rhs if pbar.disable else _progress_rhs(rhs, pbar)
+    from .budget import Overrun, projection_guard  # stop early what cannot finish (.budget)
+
+    fun = projection_guard(fun, t_end, settings.max_rhs_evals)
     while t < t_end:
         evs, tags = _events(sysm, in_contact, memory)
         te = None if own_steps else t_out[(t_out > t) & (t_out <= t_end)]
@@ -335,6 +345,14 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
             raise NumericalError(
                 f"integration stopped at t = {exc.t:.6g} s after {settings.max_rhs_evals} "
                 f"right-hand-side evaluations; {_stiffness_advice(sysm, settings)}") from None
+        except Overrun as exc:
+            pbar.close()
+            raise NumericalError(
+                f"integration stopped at t = {exc.t:.6g} s after {sysm.nfev} right-hand-side "
+                f"evaluations: at its present {exc.rate:.3g} per simulated second (mean step "
+                f"{_per_step(settings) / exc.rate:.2g} s) the run needs about {exc.projected:.3g}, "
+                f"over solver.max_rhs_evals = {settings.max_rhs_evals}; "
+                f"{_stiffness_advice(sysm, settings)}") from None
         except NonFinite as exc:
             pbar.close()
             raise NumericalError(

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-#: right-hand-side evaluations per accepted step of the explicit methods (FSAL counted once)
-EVALS_PER_STEP = {"RK45": 6, "DOP853": 12}
+from .timescales import EVALS_PER_STEP  # evaluations per accepted step (FSAL counted once)
+
 #: ``ω h`` above which the step counts as bound by the mode (the stability limit of RK45 is
 #: about 3.3 on the imaginary axis; its controller keeps the mean step near half of it: 1.5 on
 #: the benchmark slider-crank's 22.6 kHz mode)

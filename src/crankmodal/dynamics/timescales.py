@@ -9,8 +9,8 @@ axes for Dormand-Prince RK45); with the margin its error control keeps, a step o
 ``h_c = 2 tau_c`` (``lambda = -c / m``). The shorter one over the run's ``end_time``, times the
 evaluations per step, bounds the right-hand-side evaluations from below *if the joint is in
 contact the whole time* (the big ends of the four-star and slider-crank scenes are, 80-100 % of
-it, at their loads): a run whose estimate exceeds ``solver.max_rhs_evals`` cannot finish within
-its budget, and the key to change is the one whose time scale is the shorter.
+it, at their loads); :mod:`.budget` turns it into the run's estimate, refuses a run whose
+estimate exceeds ``solver.max_rhs_evals`` and names the key whose time scale is the shorter.
 
 Effective mass: ``1 / lambda_max`` of the 2x2 relative mobility of journal and bearing centres
 (the acceleration of one against the other per unit force pair, through the mass matrix and
@@ -36,13 +36,6 @@ from .laws import NormalLaw
 
 #: evaluations of the right-hand side per accepted step of the explicit methods
 EVALS_PER_STEP = {"RK45": 6, "DOP853": 12}
-#: an estimate above this fraction of ``solver.max_rhs_evals`` gives a warning
-WARN_FRACTION = 0.2
-#: an estimate above this multiple of ``solver.max_rhs_evals`` refuses the run: the estimate
-#: takes the lightest direction and contact all the time, so it runs high (measured: 2.3x the
-#: evaluations of the slider-crank at damping = 1e7, 0.75x those of the four-star at
-#: stiffness = 1e12)
-REFUSE_FACTOR = 3.0
 
 
 @dataclass
@@ -146,8 +139,12 @@ def _crank_radius(crank) -> float:
     return max((float(np.hypot(*(a - b)[:2])) for a in pts for b in pts), default=0.0)
 
 
-def joint_time_scales(mech) -> list[TimeScale]:
-    """The time scales of every clearance joint of a mechanism at its initial state."""
+def joint_time_scales(mech, low_load: bool = False) -> list[TimeScale]:
+    """The time scales of every clearance joint of a mechanism at its initial state.
+
+    ``low_load``: under the inertia load ``m omega**2 r`` alone (without the gas force), the
+    smaller load whose static penetration bounds a penetration-dependent dashpot from below
+    (:mod:`.budget`)."""
     sysm = mech.system
     omega = 2.0 * np.pi * mech.revolution_hz
     gas = _peak_gas_force(sysm)
@@ -157,7 +154,7 @@ def joint_time_scales(mech) -> list[TimeScale]:
         m = effective_mass(sysm, cj, mech.q0, mech.qd0)
         if not np.isfinite(m):
             continue
-        load = max(gas, m * omega**2 * r, 1.0)
+        load = max(0.0 if low_load else gas, m * omega**2 * r, 1.0)
         law = cj.normal
         with np.errstate(all="ignore"):  # extreme exponents/stiffnesses: no estimate, no error
             k = float(np.float64(law.tangent_stiffness(np.float64(load))))
@@ -180,50 +177,14 @@ def estimated_evals(ts: TimeScale, t_end: float, method: str) -> float | None:
 def _allowed(ts: TimeScale, h_needed: float) -> str:
     """The largest value of the responsible key that keeps the step above ``h_needed``."""
     if ts.key == "contact.damping":
-        return f"<= {2.0 * ts.mass / h_needed:.3g} N s/m"
+        # the dashpot at the load scales with the value set (IMPACT's STEP ramp: c_max s(delta))
+        scale = ts.damping_set / ts.damping if ts.damping_set else 1.0
+        return f"<= {2.0 * ts.mass / h_needed * scale:.3g} N s/m"
     k_lin_max = 4.0 * ts.mass / h_needed**2
     k = ts.law.stiffness_for_tangent(k_lin_max, ts.k_lin)
     if not ts.law.tangent_scales_exactly:  # johnson_cylinder: K_lin ~ K up to a logarithm
         return f"about <= {k:.3g} N/m"
     return f"<= {k:.3g}"
-
-
-def check_budget(scales, t_end: float, method: str, max_rhs_evals: int) -> list[str]:
-    """Refuse a run whose contact time scales need far more evaluations than its budget
-    (:data:`REFUSE_FACTOR` times).
-
-    Returns the warnings for estimates above :data:`WARN_FRACTION` of the budget.
-
-    Raises
-    ------
-    SceneError
-        Exit status 2: the scene as given cannot run within ``solver.max_rhs_evals``, which is
-        known from the input alone before any integration (like ``ring_friction_n`` and
-        ``max_step_deg``), so it is refused as bad input and no results are written.
-    """
-    from ..errors import SceneError
-
-    warnings = []
-    for ts in sorted(scales, key=lambda ts: ts.step):
-        n = estimated_evals(ts, t_end, method)
-        if n is None:
-            continue
-        if n > REFUSE_FACTOR * max_rhs_evals and ts.firm:
-            h_needed = EVALS_PER_STEP[method] * t_end / (REFUSE_FACTOR * max_rhs_evals)
-            raise SceneError(
-                f"dynamics.{ts.key}: {ts.describe()} at joint {ts.joint!r} limits "
-                f"solver.method = {method!r} to steps of {ts.step:.2g} s, at least {n:.3g} "
-                f"right-hand-side evaluations over end_time = {t_end:g} s, more than "
-                f"{REFUSE_FACTOR:g} x solver.max_rhs_evals = {max_rhs_evals}; must be "
-                f"{_allowed(ts, h_needed)} for this budget (or raise solver.max_rhs_evals, shorten end_time, or use "
-                f"solver.method = 'Radau')")
-        if n > WARN_FRACTION * max_rhs_evals:  # incl. the estimates not firm enough to refuse
-            warnings.append(
-                f"dynamics: {ts.describe()} at joint {ts.joint!r} needs steps of {ts.step:.2g} s "
-                f"with solver.method = {method!r}: about {n:.3g} right-hand-side evaluations "
-                f"while in contact ({100 * n / max_rhs_evals:.0f} % of solver.max_rhs_evals); "
-                f"the run may stop at its budget")
-    return warnings
 
 
 def responsible(scales) -> TimeScale | None:
