@@ -311,6 +311,7 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     n_steps = 0
     t0 = time.perf_counter()
     kw = {} if settings.max_step is None else {"max_step": settings.max_step}
+    stalled = 0  # restarts in a row that made no progress (grazes)
     if own_steps or (t_out.size and t_out[0] <= 0.0):
         ts.append(np.array([0.0]))
         ys.append(y[:, None].copy())
@@ -376,10 +377,12 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
             ts.append(st)
             ys.append(sy)
         t_stop = t_end
-        fired = None
+        fired = grazed = None
         for k, (j, kind) in enumerate(tags):
             for te_k, ye_k in zip(sol.t_events[k], sol.y_events[k]):
                 if memory and te_k <= t:
+                    if kind != "peak":
+                        grazed = (j, kind)  # fired again where the integration restarted
                     continue
                 if kind == "peak":  # also fires at the widest free flight: keep contacts only
                     if sysm.gap(j, ye_k[:n]) > 0.0:
@@ -398,6 +401,15 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
             if kind == "on":
                 v_impact[j] = max(onsets[j][-1][1], sysm.clearances[j].v_impact_min)
             t, y = float(t_stop), np.array(ye, float)
+            stalled = 0
+        elif sol.status == 1 and grazed is not None and stalled < 4:
+            # a graze: the contact that began at the restart point ended there too (or the
+            # reverse), within the event location's resolution; the joint takes the state the
+            # event says and the integration goes on from the same point (finishing here
+            # returned a history cut short without a word: 0.091 of 0.3 s)
+            j, kind = grazed
+            in_contact[j] = kind == "on"
+            stalled += 1
         elif sol.status == 1:
             # a terminal contact event at the restart point itself, skipped above: finishing
             # here returned a history cut short without a word (seen: 0.091 of 0.3 s)
