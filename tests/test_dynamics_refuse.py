@@ -90,7 +90,7 @@ def test_four_star_stiffness_1e12_is_not_foreseen_by_its_time_scales_but_stopped
     assert r.returncode == 3, r.stderr
     line = r.stderr.strip().splitlines()[-1]
     assert "per simulated second" in line and "lower contact.stiffness" in line
-    assert "solver.max_rhs_evals = 200000" in line
+    assert "solver.max_rhs_evals = 200000" in line and "changed regime" in line
     assert not (tmp_path / "results.json").exists()
 
 
@@ -185,6 +185,19 @@ def test_default_scenes_are_neither_refused_nor_warned(scene):
 
 
 # ---------------------------------------------------------------- the guard
+def test_an_early_stop_says_when_the_steps_fell_far_below_the_contact_time_scales():
+    from crankmodal.dynamics.laws import KelvinVoigt
+    from crankmodal.dynamics.timescales import TimeScale
+
+    # K = 1e8 N/m on 2 kg: the contact period allows steps of 2 sqrt(m / K) = 2.8e-4 s
+    ts = TimeScale("c", 2.0, 100.0, 1e8, 2 * np.pi * np.sqrt(2e-8), None, None,
+                   KelvinVoigt(1e8, 0.0))
+    note = budget.regime_note(2 * np.sqrt(2e-8) / 100, (ts,))
+    assert "100 times shorter" in note and "changed regime" in note
+    assert budget.regime_note(1e-4, (ts,)) == "" and budget.regime_note(1e-9, ()) == ""
+
+
+
 def _drive(fun, t_end, h):
     t = 0.0
     while t < t_end:

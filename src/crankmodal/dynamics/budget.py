@@ -226,6 +226,19 @@ def check(mech, t_end: float, settings) -> tuple[RunEstimate, list[str]]:
     return est, warnings
 
 
+def regime_note(mean_step: float, scales) -> str:
+    """What an early-stopped run says when its steps (``mean_step`` s) are far shorter than the
+    contact time scales ``scales`` (:class:`.timescales.TimeScale`) foresaw; else ``""``."""
+    from .timescales import responsible
+
+    ts = responsible(scales)
+    if ts is None or mean_step > 0.1 * ts.step:
+        return ""
+    return (f"its steps are {ts.step / mean_step:.0f} times shorter than the contact time "
+            f"scales foresee ({ts.step:.2g} s): the run changed regime (e.g. a journal jammed in "
+            f"its bore with its friction inside the stiction band, friction.v_static); ")
+
+
 class Overrun(Exception):
     """Raised by :func:`projection_guard` (``t``: simulated time, ``projected``: evaluations)."""
 

@@ -328,7 +328,7 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
 
     # a disabled bar (not a terminal, --quiet) leaves the right-hand side untouched
     fun = rhs if pbar.disable else _progress_rhs(rhs, pbar)
-    from .budget import Overrun, projection_guard  # stop early what cannot finish (.budget)
+    from .budget import Overrun, projection_guard, regime_note  # stop what cannot finish
 
     fun = projection_guard(fun, t_end, settings.max_rhs_evals)
     while t < t_end:
@@ -353,6 +353,7 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
                 f"evaluations: at its present {exc.rate:.3g} per simulated second (mean step "
                 f"{_per_step(settings) / exc.rate:.2g} s) the run needs about {exc.projected:.3g}, "
                 f"over solver.max_rhs_evals = {settings.max_rhs_evals}; "
+                f"{regime_note(_per_step(settings) / exc.rate, settings.time_scales)}"
                 f"{_stiffness_advice(sysm, settings)}") from None
         except NonFinite as exc:
             pbar.close()
