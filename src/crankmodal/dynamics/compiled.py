@@ -20,9 +20,9 @@ tests compare both paths state by state). The worn bore's clearance
 (:func:`.clearance.worn_bore_clearance`) and the short-bearing film
 (:func:`.lubrication.film_arguments`, :func:`.lubrication.short_film`) are not copied: they are
 Numba functions that the Python path calls too. Numba's cache does not see a change in a
-function of another module that a cached function calls (numba issue #1833): after editing those
-two modules, delete this module's cache (``__pycache__/compiled*.nb*``) or set
-``NUMBA_CACHE_DIR`` to a fresh directory; a stale kernel fails the state-by-state tests. The system is read once, when the compiled form is
+function of another module that a cached function calls (numba issue #1833): a stamp of those
+two modules beside the cache flushes this module's cached functions when they change
+(:func:`_flush_if_dependencies_changed`, run at import). The system is read once, when the compiled form is
 built: changing a joint's parameters afterwards is not seen. The impact velocities of
 restitution laws are the integrator's state, passed at every call.
 """
@@ -867,3 +867,42 @@ def _pack(arrays, dtype):
     flat = [np.asarray(a, dtype).ravel() for a in arrays]
     offsets = np.concatenate([[0], np.cumsum([a.size for a in flat])]).astype(np.int64)
     return (np.concatenate(flat) if flat else np.zeros(0, dtype)), offsets
+
+
+def _flush_if_dependencies_changed() -> bool:
+    """Flush this module's Numba cache when a module whose jitted functions it calls changed.
+
+    Numba keys a cached function on its own file only (numba issue #1833): the kernel calls
+    ``worn_bore_clearance`` (clearance.py) and ``film_arguments``/``short_film``
+    (lubrication.py), so an edit or an upgrade there would otherwise be served the old kernel.
+    A stamp of those files' bytes kept beside the cache decides; returns whether it flushed.
+    """
+    import hashlib
+    from pathlib import Path
+
+    from . import clearance, lubrication
+
+    digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes()
+                                     for m in (clearance, lubrication))).hexdigest()
+    cached = [f for f in globals().values()
+              if getattr(f, "_cache", None) is not None and hasattr(f, "py_func")]
+    try:
+        stamp = Path(cached[0]._cache._cache_path) / f"{__name__.rsplit('.', 1)[-1]}.deps"
+    except (IndexError, AttributeError):  # no cached function, or numba's internals moved
+        return False
+    try:
+        if stamp.read_text() == digest:
+            return False
+    except OSError:
+        pass
+    for f in cached:
+        f._cache.flush()
+    try:
+        stamp.parent.mkdir(parents=True, exist_ok=True)
+        stamp.write_text(digest)
+    except OSError:
+        pass  # a read-only cache: compiled again next time, never stale
+    return True
+
+
+_flush_if_dependencies_changed()
