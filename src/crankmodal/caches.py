@@ -23,6 +23,18 @@ def cache_folder(kind: str) -> Path:
     return cache_root() / kind
 
 
+def discard_damaged(path: Path, what: str, why: str, then: str = "rebuilding it") -> None:
+    """Remove a damaged cache entry with one warning line: ``"<what> <path> is damaged (<why>);
+    <then>"`` (a results ``warnings`` entry where a stage collects them)."""
+    from .errors import warn
+
+    warn(f"{what} {path} is damaged ({why}); {then}")
+    try:
+        Path(path).unlink()
+    except OSError:
+        pass  # the rebuilt entry replaces it atomically anyway
+
+
 def write_npz_atomically(path: Path, **arrays) -> Path:
     """``np.savez`` into a temporary file beside ``path``, then rename it into place.
 

@@ -33,8 +33,9 @@ GEOMETRY_TOLERANCE = 0.01
 
 def flexbody_cache_dir() -> Path:
     """``$CRANKMODAL_CACHE/flexbodies`` (default ``~/.cache/crankmodal/flexbodies``)."""
-    root = os.environ.get("CRANKMODAL_CACHE") or Path.home() / ".cache" / "crankmodal"
-    return Path(root) / "flexbodies"
+    from ..caches import cache_folder
+
+    return cache_folder("flexbodies")
 
 
 def cached_flexbody(path: Path, where: str) -> bool:
@@ -42,7 +43,8 @@ def cached_flexbody(path: Path, where: str) -> bool:
     emptied: :func:`~crankmodal.reduction.io.load_flexbody` refuses it) is removed with a
     one-line warning naming it and what is wrong, so that the caller rebuilds it, as
     :mod:`crankmodal.geometry.cache` does for parts."""
-    from ..errors import InputFileError, warn
+    from ..caches import discard_damaged
+    from ..errors import InputFileError
     from ..reduction.io import load_flexbody
 
     if not path.is_file():
@@ -53,11 +55,7 @@ def cached_flexbody(path: Path, where: str) -> bool:
     except InputFileError as exc:
         why = getattr(exc, "member", "")
         why = f"{why}: {exc.text}" if why else getattr(exc, "text", str(exc))
-        warn(f"{where}: the cached flexbody {path} is damaged ({why}); rebuilding it")
-        try:
-            path.unlink()
-        except OSError:
-            pass  # save_flexbody replaces it atomically anyway
+        discard_damaged(path, f"{where}: the cached flexbody", why)
         return False
 
 

@@ -82,7 +82,7 @@ def _spd_solve(A, b):
     from scipy.sparse.linalg import splu
 
     return splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                options=dict(SymmetricMode=True)).solve(b)
+                options={"SymmetricMode": True}).solve(b)
 
 
 def _solve_lcp(K, g, fixed, guess=None, max_iter=200):
@@ -259,8 +259,7 @@ def _table_values(l_over_d: float, n_theta: int, n_zeta: int) -> np.ndarray:
     import json
     from pathlib import Path
 
-    from ..caches import cache_folder, write_npz_atomically
-    from ..errors import warn
+    from ..caches import cache_folder, discard_damaged, write_npz_atomically
 
     shape = (EPS_TABLE.size, ALPHA_TABLE.size, 2)
     key = hashlib.sha256(json.dumps({
@@ -277,8 +276,8 @@ def _table_values(l_over_d: float, n_theta: int, n_zeta: int) -> np.ndarray:
                 raise ValueError(f"member 'forces' has shape {values.shape}, or is not finite")
             return values
         except Exception as exc:  # noqa: BLE001 - any damage: the table is solved again
-            warn(f"film table cache {path}: damaged ({type(exc).__name__}: {exc}); solved again")
-            path.unlink(missing_ok=True)
+            discard_damaged(path, "the cached film table", f"{type(exc).__name__}: {exc}",
+                            then="solved again")
     values = np.zeros(shape)
     for k, e in enumerate(EPS_TABLE):
         s = 1.0 - e * e

@@ -21,8 +21,9 @@ from .. import __version__
 
 def cache_dir() -> Path:
     """Folder of cached parts (``$CRANKMODAL_CACHE/parts`` or ``~/.cache/crankmodal/parts``)."""
-    root = os.environ.get("CRANKMODAL_CACHE") or Path.home() / ".cache" / "crankmodal"
-    return Path(root) / "parts"
+    from ..caches import cache_folder
+
+    return cache_folder("parts")
 
 
 def file_digest(path) -> str:
@@ -66,13 +67,9 @@ def load_part(key: str):
         why = f"holds a {type(part).__name__}, not a part"
     except Exception as exc:  # noqa: BLE001 - a truncated or stale entry is rebuilt, never trusted
         why = f"{type(exc).__name__}: {exc}"
-    from ..errors import warn
+    from ..caches import discard_damaged
 
-    warn(f"geometry.cache: the cached part {path} is damaged ({why}); rebuilding it")
-    try:
-        path.unlink()
-    except OSError:
-        pass  # store_part replaces it atomically anyway
+    discard_damaged(path, "geometry.cache: the cached part", why)
     return None
 
 
