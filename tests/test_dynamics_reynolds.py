@@ -202,7 +202,7 @@ def _film_within_half_percent_and_0p3_deg_off_the_nodes(l_over_d, n, seed):
 def test_finite_film_of_the_dynamics_equals_steady_bearing_between_the_table_nodes(oracle):
     # issue 27: over eps <= 0.95 with squeeze, at points not used to build the table (L/D of
     # seed 001's bearing, 1.05; the other L/D in the slow test below)
-    load, att = _film_within_half_percent_and_0p3_deg_off_the_nodes(L / (2 * R), 12, 5)
+    load, _ = _film_within_half_percent_and_0p3_deg_off_the_nodes(L / (2 * R), 12, 5)
     oracle(stage="dynamics", quantity="finite film force of the dynamics off the table nodes "
            "(L/D 1.05, eps <= 0.95, with squeeze), worst load error",
            reference="steady Reynolds solve (steady_bearing / solve_pressure)", tolerance="0.5 %",

@@ -15,10 +15,10 @@ import re
 
 import numpy as np
 import pytest
+from conftest import SCENES, run_cli, run_in_process
 
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
-from conftest import SCENES, run_cli, run_in_process
 
 PROGRESS = re.compile(r"\[\w+\] (running|done in [0-9.]+ s)$")
 

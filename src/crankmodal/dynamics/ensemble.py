@@ -130,8 +130,8 @@ def headline_text(block: dict, n_revolutions: int) -> str:
         text = f"{_label(key)} {number(h['value'] / k)}"  # never e+NN (issue 25 #15)
         if h["uncertainty"] > 0.0:
             text += f" ± {number(h['uncertainty'] / k, 2)}"
-        parts.append((text + (f" {unit}" if unit else "")
-                      + (" (spread)" if h["basis"] == "ensemble spread" else "")))
+        parts.append(text + (f" {unit}" if unit else "")
+                      + (" (spread)" if h["basis"] == "ensemble spread" else ""))
         n_traj = h["n_trajectories"]
     return (", ".join(parts) + f" (per-revolution means over {n_traj} trajector"
             f"{'ies' if n_traj > 1 else 'y'} x {n_revolutions} revs; ±: standard error, or the "

@@ -140,9 +140,9 @@ class SuperLUFactor:
         n, avail = A.shape[0], available_bytes()
         # symmetric positive definite: minimum degree on A + A^T and diagonal pivots (SuperLU's
         # symmetric mode), half the time of the general COLAMD ordering on a crank mesh
-        kw = (dict(permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                   options=dict(SymmetricMode=True)) if positive_definite
-              else dict(permc_spec="COLAMD"))
+        kw = ({"permc_spec": "MMD_AT_PLUS_A", "diag_pivot_thresh": 0.0,
+               "options": {"SymmetricMode": True}} if positive_definite
+              else {"permc_spec": "COLAMD"})
         try:
             with address_space_limit(avail):
                 self._lu = splu(sp.csc_matrix(A), **kw)

@@ -35,7 +35,13 @@ Only numpy and scipy are imported here; nothing pulls in gmsh, scikit-fem or pyv
 from .chain import ChainModes, TorsionalChain, exact_modes
 from .damping import Damper
 from .excitation import CrankEnd, PressureTable, cylinder_efforts, rotor_excitation
-from .forced import DampedTrain, ForcedResponse, damped_train, energy_balance_amplitude, steady_state
+from .forced import (
+    DampedTrain,
+    ForcedResponse,
+    damped_train,
+    energy_balance_amplitude,
+    steady_state,
+)
 from .holzer import HolzerResult, holzer, holzer_table
 from .stress import Allowable, Section
 from .two_rotor import TwoRotorResult, reduce_to_two_rotors, two_rotor
@@ -47,19 +53,19 @@ __all__ = [
     "DampedTrain",
     "Damper",
     "ForcedResponse",
+    "HolzerResult",
     "PressureTable",
     "Section",
+    "TorsionalChain",
+    "TwoRotorResult",
     "cylinder_efforts",
     "damped_train",
     "energy_balance_amplitude",
-    "rotor_excitation",
-    "steady_state",
-    "HolzerResult",
-    "TorsionalChain",
-    "TwoRotorResult",
     "exact_modes",
     "holzer",
     "holzer_table",
     "reduce_to_two_rotors",
+    "rotor_excitation",
+    "steady_state",
     "two_rotor",
 ]

@@ -199,7 +199,7 @@ class CylinderEfforts:
 
     def harmonic_indices(self, max_order: float) -> np.ndarray:
         """Cycle harmonics ``k = 1 .. max_order x cycle_revolutions``."""
-        kmax = int(math.floor(max_order * self.cycle_revolutions + 1e-9))
+        kmax = math.floor(max_order * self.cycle_revolutions + 1e-9)
         if kmax < 1:
             raise ParameterError("max_order", f"must be >= {1 / self.cycle_revolutions:g}, got {max_order}")
         if 2 * kmax >= len(self.theta):
@@ -251,12 +251,11 @@ def cylinder_efforts(machine, arrangement=None, pressure_table: PressureTable | 
     -------
     CylinderEfforts
     """
+    from .. import arguments as arg
     from ..mechanism import forces as fo
     from ..mechanism import gas as ga
     from ..mechanism.analysis import analyse
     from ..mechanism.kinematics import kinematic_ratio
-
-    from .. import arguments as arg
     from ..mechanism.machine import Machine
 
     arg.instance("machine", machine, Machine, "a crankmodal.mechanism.machine.Machine")
@@ -394,7 +393,7 @@ def rotor_excitation(n_rotors: int, max_order: float, cycle_revolutions: int,
     schema = {"rotor": Field("int", doc="0-based rotor", ge=0), "order": Field("float", doc="order", gt=0.0),
               "amplitude": Field("float", doc="N m", ge=0.0), "phase_deg": Field("float", 0.0, "deg")}
     harmonics = [arg.table_by(f"harmonics[{i}]", h, schema) for i, h in enumerate(harmonics)]
-    kmax = int(math.floor(max_order * cycle_revolutions + 1e-9))
+    kmax = math.floor(max_order * cycle_revolutions + 1e-9)
     if kmax < 1:
         raise ParameterError("max_order", f"must be >= {1 / cycle_revolutions:g}, got {max_order}")
     orders = np.arange(1, kmax + 1) / cycle_revolutions

@@ -224,7 +224,7 @@ def half_peak_to_peak(coefficients: np.ndarray, harmonics: np.ndarray) -> tuple[
     k = np.asarray(harmonics, int)
     kmax = int(k.max())
     shape = X.shape[:-1]
-    n = 1 << max(6, int(math.ceil(math.log2(8 * kmax + 1))))
+    n = 1 << max(6, math.ceil(math.log2(8 * kmax + 1)))
     phi = 2 * math.pi * np.arange(n) / n
     basis = np.concatenate([np.cos(np.outer(k, phi)), -np.sin(np.outer(k, phi))])
     flat = X.reshape(-1, len(k))
