@@ -206,27 +206,34 @@ def _drive(fun, t_end, h):
 
 
 def test_guard_projects_a_constant_rate_to_its_exact_count_and_stops_it():
-    # steps of 1e-4 s over 1 s need 1e4 evaluations; budget 1000: stopped after one window
-    fun = budget.projection_guard(lambda t, y: None, 1.0, 1000)
+    # steps of 1e-5 s over 1 s need 1e5 evaluations; budget 20000: judged from 0.2 s (20 % of
+    # the run, 20001 evaluations: past 20 % of the budget), and stopped there
+    fun = budget.projection_guard(lambda t, y: None, 1.0, 20_000)
     with pytest.raises(budget.Overrun) as exc:
-        _drive(fun, 1.0, 1e-4)
-    assert exc.value.projected == pytest.approx(1e4, rel=1e-6)  # float sums of h: 1e-6 is
-    assert exc.value.t == pytest.approx(0.01, abs=2e-4)          # far above their rounding
+        _drive(fun, 1.0, 1e-5)
+    assert exc.value.projected == pytest.approx(1e5, rel=1e-4)  # float sums of h: 1e-4 is
+    assert exc.value.t == pytest.approx(0.2, abs=2e-4)           # far above their rounding
+
+
+def test_guard_leaves_a_small_budget_to_the_budget_itself():
+    # 1000 evaluations at most: the guard never judges, the budget stops the run
+    fun = budget.projection_guard(lambda t, y: None, 1.0, 1000)
+    _drive(fun, 0.1, 1e-4)
 
 
 def test_guard_lets_a_burst_shorter_than_its_window_pass():
-    # 1 ms steps over 1 s (1000 evaluations) with 50 more in 1 ms at 0.5 s, budget 10000: the
-    # window holding the burst runs at 6000 per s, 2940 for the 0.49 s left, within the budget
-    fun = budget.projection_guard(lambda t, y: None, 1.0, 10_000)
-    _drive(fun, 0.5, 1e-3)
-    for k in range(50):
-        fun(0.5 + (k + 1) * 2e-5, None)
-    for k in range(500):
-        fun(0.501 + k * 1e-3, None)
-    with pytest.raises(budget.Overrun):  # budget 2000: 1.5 x the 1450 left = 2175 < 2940
-        fun = budget.projection_guard(lambda t, y: None, 1.0, 2000)
-        _drive(fun, 0.5, 1e-3)
-        for k in range(50):
-            fun(0.5 + (k + 1) * 2e-5, None)
-        for k in range(500):
-            fun(0.501 + k * 1e-3, None)
+    # 0.1 ms steps over 1 s (1e4 evaluations) with 500 more in 1 ms at 0.5 s, budget 4e4:
+    # the window holding the burst runs at 6e4 per s, 2.94e4 for the 0.49 s left, within
+    # 1.5 x the 3.45e4 left; on a budget of 2e4 (1.5 x 1.45e4 = 2.2e4 < 2.94e4) it stops
+    for limit, stops in ((40_000, False), (20_000, True)):
+        fun = budget.projection_guard(lambda t, y: None, 1.0, limit)
+        try:
+            _drive(fun, 0.5, 1e-4)
+            for k in range(500):
+                fun(0.5 + (k + 1) * 2e-6, None)
+            for k in range(5000):
+                fun(0.501 + k * 1e-4, None)
+        except budget.Overrun:
+            assert stops
+        else:
+            assert not stops
