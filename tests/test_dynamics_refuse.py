@@ -206,13 +206,13 @@ def _drive(fun, t_end, h):
 
 
 def test_guard_projects_a_constant_rate_to_its_exact_count_and_stops_it():
-    # steps of 1e-5 s over 1 s need 1e5 evaluations; budget 20000: judged from 0.2 s (20 % of
-    # the run, 20001 evaluations: past 20 % of the budget), and stopped there
+    # steps of 1e-5 s over 1 s need 1e5 evaluations; budget 20000: judged from 0.1 s (10 % of
+    # the run, 10001 evaluations, past 2 % of the budget and 1000), and stopped there
     fun = budget.projection_guard(lambda t, y: None, 1.0, 20_000)
     with pytest.raises(budget.Overrun) as exc:
         _drive(fun, 1.0, 1e-5)
     assert exc.value.projected == pytest.approx(1e5, rel=1e-4)  # float sums of h: 1e-4 is
-    assert exc.value.t == pytest.approx(0.2, abs=2e-4)           # far above their rounding
+    assert exc.value.t == pytest.approx(0.1, abs=2e-4)           # far above their rounding
 
 
 def test_guard_leaves_a_small_budget_to_the_budget_itself():

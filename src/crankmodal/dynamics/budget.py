@@ -53,11 +53,12 @@ COST_PER_EVAL = {"compiled": 60e-6, "python": 600e-6}
 #: a run stops early when its present evaluation rate needs this multiple of the evaluations
 #: left of its budget (:func:`projection_guard`)
 GUARD_FACTOR = 1.5
-#: the early stop judges only after this fraction of ``end_time`` and of the budget (and
-#: :data:`GUARD_MIN_EVALS` evaluations): a run's start-up can be stiff for a while and then
-#: relax (an oil film from a centred journal: Radau at 5e6 evaluations per simulated second for
-#: its first 13 %, 3402 in all), and on a small budget the budget itself stops a run soon enough
-GUARD_START_FRACTION = 0.2
+#: the early stop judges only after this fraction of ``end_time``, :data:`GUARD_BUDGET_FRACTION`
+#: of the budget and :data:`GUARD_MIN_EVALS` evaluations: a run's start-up can be stiff for a
+#: while and then relax (an oil film from a centred journal: 5e6 evaluations per simulated
+#: second for its first 13 %), and on a small budget the budget itself stops a run soon enough
+GUARD_START_FRACTION = 0.1
+GUARD_BUDGET_FRACTION = 0.02
 GUARD_MIN_EVALS = 1000
 
 
@@ -259,14 +260,14 @@ def projection_guard(fun, t_end: float, max_rhs_evals: int, window: float | None
     Over every window of simulated time (default ``t_end / 100``) the evaluations per simulated
     second are measured; when that rate, kept over the time left, needs more than
     :data:`GUARD_FACTOR` times the evaluations left of ``max_rhs_evals``, :class:`Overrun` is
-    raised, once :data:`GUARD_START_FRACTION` of ``t_end`` has passed and as much of the budget
-    (at least :data:`GUARD_MIN_EVALS`) is spent. A burst of short steps through one impact lasts far less than a window (the
+    raised, once :data:`GUARD_START_FRACTION` of ``t_end`` has passed and
+    :data:`GUARD_BUDGET_FRACTION` of the budget (at least :data:`GUARD_MIN_EVALS`) is spent. A burst of short steps through one impact lasts far less than a window (the
     four-star's contacts last 0.1-1 ms against a 5 ms window), so it does not stop a run; a
     regime that holds for a window (a jammed journal, a stiff dashpot in long contact) does.
     """
     window = window or t_end / 100.0
     state = {"n": 0, "t0": 0.0, "n0": 0}
-    start = max(GUARD_START_FRACTION * max_rhs_evals, GUARD_MIN_EVALS)
+    start = max(GUARD_BUDGET_FRACTION * max_rhs_evals, GUARD_MIN_EVALS)
 
     def guarded(t, y):
         state["n"] += 1
