@@ -237,3 +237,17 @@ def test_guard_lets_a_burst_shorter_than_its_window_pass():
             assert stops
         else:
             assert not stops
+
+
+def test_a_kept_mode_bounds_the_estimate_at_two_over_omega_and_names_its_table():
+    # a 20 kHz mode of 'rod_1': RK45 steps of 2 / (2 pi 20e3) = 1.59e-5 s over 0.1 s
+    body = SimpleNamespace(name="rod_1", n_elastic=2, frequencies_hz=np.array([5e3, 2e4, 0.0]))
+    mech = SimpleNamespace(system=SimpleNamespace(bodies=[body], clearances=[],
+                                                  kernel=lambda: None))
+    s = SolverSettings(method="RK45", max_step=1e-3, max_rhs_evals=10_000)
+    est = budget.estimate(mech, 0.1, s)
+    assert est.evaluations == pytest.approx(6 * 0.1 / 1e-3 + 6 * 0.1 * 2 * np.pi * 2e4 / 2,
+                                            rel=1e-12)
+    with pytest.raises(ParameterError) as exc:  # 3.8e4 estimated, over 3 x 1e4
+        budget.check(mech, 0.1, s)
+    assert exc.value.argument == "flexible.rods" and "flexible.rods.n_modes" in exc.value.text

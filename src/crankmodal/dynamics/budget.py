@@ -74,8 +74,7 @@ class Stiff:
     def advice(self, h_needed: float) -> str:
         """What to change so the step reaches ``h_needed`` s."""
         if self.scale is None:
-            body = self.key.split(".", 1)[1]
-            return (f"keep fewer modes of {body!r} (its n_modes or cutoff_hz below "
+            return (f"keep fewer modes ({self.key}.n_modes, or cutoff_hz below "
                     f"{2.0 / h_needed / (2.0 * np.pi):.3g} Hz) or use solver.method = 'Radau'")
         from .timescales import _allowed
 
@@ -130,8 +129,10 @@ def _mode_scale(mech) -> Stiff | None:
     top = stiffest_mode(bodies)
     if top is None:
         return None
+    from .flexstage import flexible_key  # rod_2 -> dynamics.flexible.rods
+
     name, hz = top
-    return Stiff(f"flexible.{name}", 2.0 / (2.0 * np.pi * hz),
+    return Stiff(flexible_key(name).removeprefix("dynamics."), 2.0 / (2.0 * np.pi * hz),
                  f"the {hz:.4g} Hz mode of {name!r} (kept elastic mode)")
 
 

@@ -146,6 +146,8 @@ def joint_time_scales(mech, low_load: bool = False) -> list[TimeScale]:
     smaller load whose static penetration bounds a penetration-dependent dashpot from below
     (:mod:`.budget`)."""
     sysm = mech.system
+    if not sysm.clearances:
+        return []
     omega = 2.0 * np.pi * mech.revolution_hz
     gas = _peak_gas_force(sysm)
     r = _crank_radius(mech.crank)
