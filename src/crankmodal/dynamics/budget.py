@@ -202,13 +202,13 @@ def check(mech, t_end: float, settings) -> tuple[RunEstimate, list[str]]:
     from ..errors import ParameterError
 
     memo_key = (t_end, settings.method, settings.max_rhs_evals, settings.max_step)
-    memo = getattr(mech, "_budget_checked", None)
-    if memo is not None and memo[0] == memo_key:  # checked and warned already (a scene
-        return memo[1], []                          # checks, then simulate(); ensembles)
+    memo = getattr(mech.system, "_budget_checked", None)
+    if memo is not None and memo[0] == memo_key:  # checked and warned already (a scene,
+        return memo[1], []                          # then simulate(); ensemble members)
     est = estimate(mech, t_end, settings)
     budget = settings.max_rhs_evals
     if est.evaluations is None:
-        mech._budget_checked = (memo_key, est)
+        mech.system._budget_checked = (memo_key, est)
         return est, []
     if est.evaluations > REFUSE_FACTOR * budget and est.stiff is not None:
         stiff, n = est.stiff, est.evaluations
@@ -230,7 +230,7 @@ def check(mech, t_end: float, settings) -> tuple[RunEstimate, list[str]]:
             f"{est.evaluations:.3g} right-hand-side evaluations ({100 * est.evaluations / budget:.0f} "
             f"% of solver.max_rhs_evals), estimated wall time {_seconds(est.wall_time)}; "
             f"the run may stop at its budget")
-    mech._budget_checked = (memo_key, est)
+    mech.system._budget_checked = (memo_key, est)
     return est, warnings
 
 
