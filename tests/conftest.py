@@ -145,3 +145,14 @@ def pytest_sessionfinish(session, exitstatus):
     tmp = path.with_suffix(".json.tmp")
     tmp.write_text(text, encoding="utf-8")
     tmp.replace(path)
+
+
+@pytest.fixture(scope="module")
+def client():
+    """One local Dask cluster of two worker processes per test module (as the sweep CLI makes
+    it), for the sweep tests."""
+    pytest.importorskip("dask.distributed")
+    from crankmodal.sweep.driver import dask_client
+
+    with dask_client(workers=2) as c:
+        yield c

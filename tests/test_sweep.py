@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from sweep_support import F1, MECH, ROOT, THROW, write_sweep
 
 from crankmodal.cli import main
 from crankmodal.errors import CrankmodalError, SceneError
@@ -20,28 +21,6 @@ from crankmodal.sweep import load_sweep, run_sweep
 from crankmodal.sweep.axes import generate, parse_axis
 from crankmodal.sweep.driver import plan_tasks
 from crankmodal.sweep.store import RecordStore
-
-ROOT = Path(__file__).resolve().parents[1]
-MECH = ROOT / "scenes" / "four_star_mechanism.toml"
-THROW = "mechanism.cylinders.0.throw_angle_deg"
-F1 = "mechanism.first_order_force_max_n"
-
-
-def write_sweep(tmp_path, text, name="sw.toml"):
-    p = tmp_path / name
-    p.write_text(f'base = "{MECH}"\n' + text)
-    return p
-
-
-@pytest.fixture(scope="module")
-def client():
-    """One local cluster of two worker processes for the module (as the CLI makes it)."""
-    pytest.importorskip("dask.distributed")
-    from crankmodal.sweep.driver import dask_client
-
-    with dask_client(workers=2) as c:
-        yield c
-
 
 # ---------------------------------------------------------------- generation
 

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from sweep_support import F1, ROOT, THROW, write_sweep
 
 from crankmodal.cli import main
 from crankmodal.errors import SceneError
@@ -30,27 +31,7 @@ from crankmodal.sweep.driver import FAILED_EXIT, plan_tasks
 from crankmodal.sweep.search import initial_steps, refine
 from crankmodal.sweep.store import RecordStore, record_problem
 
-ROOT = Path(__file__).resolve().parents[1]
-MECH = ROOT / "scenes" / "four_star_mechanism.toml"
 SWEEPS = ROOT / "scenes" / "sweeps"
-THROW = "mechanism.cylinders.0.throw_angle_deg"
-F1 = "mechanism.first_order_force_max_n"
-
-
-def write_sweep(tmp_path, text, name="sw.toml"):
-    p = tmp_path / name
-    p.write_text(f'base = "{MECH}"\n' + text)
-    return p
-
-
-@pytest.fixture(scope="module")
-def client():
-    """One local cluster of two worker processes for the module (as the CLI makes it)."""
-    pytest.importorskip("dask.distributed")
-    from crankmodal.sweep.driver import dask_client
-
-    with dask_client(workers=2) as c:
-        yield c
 
 
 # ---------------------------------------------------------------- records (untrusted file)
