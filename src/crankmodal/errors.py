@@ -7,26 +7,56 @@ subclass of :class:`CrankmodalError`. The CLI turns it into one line on stderr a
 
 
 class CrankmodalError(Exception):
-    """Base class of the errors a user can fix; the message names the offending value."""
+    """Base class of the errors a user can fix; the message names the offending value.
+
+    Attributes
+    ----------
+    exit_code : int
+        The CLI's exit status for it: 2 (bad input; 3 for :class:`NumericalError`).
+    """
 
     exit_code = 2
 
 
 class SceneError(CrankmodalError):
-    """A scene key is unknown, of the wrong type, or out of its admissible range."""
+    """A scene key is unknown, of the wrong type, or out of its admissible range.
+
+    Attributes
+    ----------
+    exit_code : int
+        2: the CLI exits with status 2 and one line naming the key; no results.json is written.
+    """
 
 
 class InputFileError(CrankmodalError):
-    """A file named in a scene is missing or unreadable."""
+    """A file named in a scene is missing or unreadable.
+
+    Attributes
+    ----------
+    exit_code : int
+        2: the CLI exits with status 2 and one line naming the file (and member, where it has one).
+    """
 
 
 class OutputError(CrankmodalError):
     """An output file or folder cannot be written (the folder is a file, read-only, the disk is
-    full); the message names the path and the system's reason."""
+    full); the message names the path and the system's reason.
+
+    Attributes
+    ----------
+    exit_code : int
+        2: the CLI exits with status 2 and one line; nothing is half-written.
+    """
 
 
 class GeometryError(CrankmodalError):
-    """A parameter set describes an impossible part, or the geometry kernel failed on it."""
+    """A parameter set describes an impossible part, or the geometry kernel failed on it.
+
+    Attributes
+    ----------
+    exit_code : int
+        2: the CLI exits with status 2 and one line naming the parameter.
+    """
 
 
 class ResourceError(CrankmodalError):
@@ -35,7 +65,13 @@ class ResourceError(CrankmodalError):
 
 
 class NumericalError(CrankmodalError):
-    """A computation did not meet its own accuracy checks; the message says what to change."""
+    """A computation did not meet its own accuracy checks; the message says what to change.
+
+    Attributes
+    ----------
+    exit_code : int
+        3: the CLI exits with status 3 and one line of advice.
+    """
 
     exit_code = 3
 

@@ -31,6 +31,9 @@ def _dirs(kind: str) -> list[Path]:
 def list_machines() -> list[str]:
     """Names of the machine parameter files found, sorted.
 
+    The folders searched are ``$CRANKMODAL_MACHINES`` (a path list, first), the repository's
+    ``geometry/`` and the wheel's packaged machines.
+
     Returns
     -------
     list of str

@@ -79,7 +79,22 @@ def _restitution(value) -> float:
 # ---------------------------------------------------------------------------------- normal laws
 @dataclass(frozen=True)
 class NormalLaw:
-    """Base of the normal force laws (see the module docstring)."""
+    """Base of the normal force laws (see the module docstring).
+
+    A law is a frozen dataclass of its parameters (SI: stiffness in N/m^exponent, damping in
+    N s/m, lengths in m) that answers for itself: ``force(delta, delta_dot, v_impact)`` (N) for
+    a penetration ``delta`` (m) and its rate (m/s), ``elastic_force(delta)``, its time scales
+    and its Hertz stiffness. Build one by name with :func:`make_law`.
+
+    Attributes
+    ----------
+    name : str
+        The law's scene name (``contact.law``).
+    code : int
+        Its number in the compiled kernel.
+    needs_impact_velocity : bool
+        Whether the force depends on the velocity at the contact's onset (restitution laws).
+    """
 
     name: ClassVar[str] = ""
     code: ClassVar[int] = -1
@@ -452,7 +467,19 @@ def make_law(name: str, params=None) -> NormalLaw:
 # ---------------------------------------------------------------------------------- friction
 @dataclass(frozen=True)
 class FrictionLaw:
-    """Base of the friction laws: ``coefficient(v)`` signed like the slip velocity ``v``."""
+    """Base of the friction laws: ``coefficient(v)`` signed like the slip velocity ``v``.
+
+    A law is a frozen dataclass of its parameters (coefficients, and transition velocities in
+    m/s); ``coefficient(v)`` is the friction coefficient at slip velocity ``v`` (m/s). Build one
+    by name with :func:`make_friction`.
+
+    Attributes
+    ----------
+    name : str
+        The law's scene name (``contact.friction``).
+    code : int
+        Its number in the compiled kernel.
+    """
 
     name: ClassVar[str] = ""
     code: ClassVar[int] = -1

@@ -65,7 +65,25 @@ _ARRAYS = ("frequencies_hz", "stiffness", "mass", "rigid", "interface_centres", 
 
 
 def save_flexbody(path, body: FlexibleBody) -> Path:
-    """Write ``body`` to ``path`` (``.npz``, uncompressed); returns the path."""
+    """Write ``body`` to ``path`` (``.npz``, uncompressed, atomically); returns the path.
+
+    Parameters
+    ----------
+    path : str or Path
+        File name; written as given (``np.savez`` would append ``.npz`` to a name without it).
+    body : FlexibleBody
+        A reduced body (:func:`~crankmodal.reduction.reduce.reduce_body` or :func:`load_flexbody`).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ParameterError
+        ``path`` is no file name, or ``body`` is not a reduced body.
+    """
     from ..arguments import instance
     from ..arguments import path as path_argument
 
@@ -252,6 +270,16 @@ def _open(path: Path):
 
 def load_flexbody(path) -> FlexibleBody:
     """Read a body written by :func:`save_flexbody`, validating every member.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``crankmodal-flexbody`` ``.npz`` file.
+
+    Returns
+    -------
+    FlexibleBody
+        The reduced body: its matrices, interfaces, invariants and stress modes (SI units).
 
     The file is untrusted: each member is checked for its kind (text, integer, real numbers;
     never pickled objects), its shape against the body's ``n`` modes, ``m`` interfaces and ``p``
