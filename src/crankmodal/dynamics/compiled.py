@@ -2,13 +2,13 @@
 
 For a system of rigid and planar flexible (floating-frame, modal) bodies joined by pins, sliders
 and angle drives, with clearance joints (round or worn elliptical bores, dry or with the
-short-bearing oil film; any law of :mod:`.laws`), piston loads (gas force and ring friction) and
+short-bearing or the finite-length oil film; any law of :mod:`.laws`), piston loads (gas force and ring friction) and
 crank torques, :class:`CompiledSystem` evaluates what
 :meth:`Multibody.solve` and :meth:`Multibody.rhs` evaluate in two Numba-compiled calls
 (``cache=True``: compiled once per machine, ~20 s, then loaded in ~1 s) around LAPACK's solve:
 :func:`assemble` (frame table, flexible-body terms, applied and contact forces, constraint terms
 and the linear system) and :func:`finish` (accelerations, multipliers, powers). An all-rigid
-system's diagonal mass matrix is eliminated first (the system left is the multipliers' and the
+system without an oil film has its diagonal mass matrix eliminated first (the system left is the multipliers' and the
 massless coordinates'); with a flexible body, whose ``M(ξ)`` is full in its (θ, ξ) block, the
 whole KKT system is solved. The Python path costs ~0.25 ms (rigid four-star with one clearance
 joint) to ~1 ms (flexible) per evaluation in some hundred small NumPy calls; this one ~0.02 ms
@@ -40,6 +40,7 @@ from .flexible import FlexibleBody
 from .joints import AngleDrive, Prismatic, Revolute
 from .loads import CrankTorque, PistonLoads
 from .lubrication import film_arguments, short_film
+from .reynolds import film_spline, finite_film
 
 #: per clearance joint diagnostics written by the kernel (columns of ``diag``)
 DIAG = ("ex", "ey", "nx", "ny", "d", "delta", "delta_dot", "v_slip", "fn", "ft", "fx", "fy",
@@ -61,9 +62,8 @@ def applicable(sysm) -> bool:
     """True when every part of ``sysm`` has a compiled form (see the module docstring).
 
     Clearance joints: round and worn (elliptical) bores, dry or with the short-bearing film
-    (``film_model = "short"``). A finite-length film (``film_model = "finite"``: the Reynolds
-    table of :mod:`.reynolds`, SciPy splines looked up per call) has no compiled form yet, so
-    a system with one runs on the Python path.
+    (``film_model = "short"``) or the finite-length film (``"finite"``: the Reynolds table of
+    :mod:`.reynolds`, evaluated by its own :func:`.reynolds.finite_film` in both paths).
     """
     if not all(type(b) in _BODIES for b in sysm.bodies):
         return False
@@ -72,7 +72,7 @@ def applicable(sysm) -> bool:
     for cj in sysm.clearances:
         if type(cj) is not ClearanceJoint:
             return False
-        if cj.viscosity is not None and cj.film_model != "short":
+        if cj.viscosity is not None and cj.film_model not in ("short", "finite"):
             return False
         if not all(isinstance(b, (*_BODIES, Ground)) for b in (cj.journal, cj.bearing)):
             return False
@@ -359,11 +359,11 @@ def _flexible(q, qd, fb_int, fb_f, Q, A):
 #: order of the integer tables packed into ``I`` (see :class:`CompiledSystem`)
 INT_TABLES = ("fcol", "fmn", "fmoff", "fadoff", "rev_rows", "rev_a", "rev_b", "pri_rows",
               "pri_k", "drive_rows", "drive_k", "cl_int", "pl_int", "gas_off", "tq_k",
-              "is_drive", "col_ptr", "col_rows", "massless", "fb_int", "full")
+              "is_drive", "col_ptr", "col_rows", "massless", "fb_int", "full", "film_off")
 #: order of the float tables packed into ``F``
 FLOAT_TABLES = ("floc", "fmodal", "mdiag", "Q0", "pri_n", "pri_o", "pri_ang", "cl_f", "law_vec",
                 "fric_vec", "pl_f", "gas_x", "gas_f", "gas_period", "tq_val", "baumgarte",
-                "fb_f")
+                "fb_f", "film_spl")
 
 
 @njit(cache=True)
@@ -408,6 +408,7 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
     fric_vec, pl_f = _seg(F, fo, 9).reshape((-1, 4)), _seg(F, fo, 10).reshape((-1, 6))
     gas_x, gas_f, gas_period = _seg(F, fo, 11), _seg(F, fo, 12), _seg(F, fo, 13)
     tq_val, baumgarte, fb_f = _seg(F, fo, 14), F[fo[15]], _seg(F, fo, 16)
+    film_off, film_spl = _seg(I, io, 21), _seg(F, fo, 17)
     K = fr[0].size
     pose = np.empty((K, 3))
     arm = np.empty((K, 2))
@@ -438,13 +439,17 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
         fy = -fn * row[20] + ft * nx
         p_film = 0.0
         row[23] = 0.0
-        if cl_int[j, 4]:  # short-bearing film on the minor clearance
+        if cl_int[j, 4]:  # a film (1: short bearing, 2: finite length) on the minor clearance
             vrx, vry = row[16], row[17]
             eps, wedge, eps_dot = film_arguments(row[4], nx * vrx + ny * vry,
                                                  -ny * vrx + nx * vry, row[18], cl_f[j, 0],
                                                  cl_f[j, 7])
-            f_r, f_t = short_film(eps, wedge, eps_dot, cl_f[j, 5], cl_f[j, 1], cl_f[j, 6],
-                                  cl_f[j, 0])
+            if cl_int[j, 4] == 2:  # finite-length film: the Reynolds table
+                f_r, f_t = finite_film(eps, wedge, eps_dot, cl_f[j, 5], cl_f[j, 1], cl_f[j, 6],
+                                       cl_f[j, 0], film_spl[film_off[j]:])
+            else:
+                f_r, f_t = short_film(eps, wedge, eps_dot, cl_f[j, 5], cl_f[j, 1], cl_f[j, 6],
+                                      cl_f[j, 0])
             ffx = f_r * nx + f_t * -ny
             ffy = f_r * ny + f_t * nx
             p_film = ffx * vrx + ffy * vry
@@ -673,10 +678,15 @@ class CompiledSystem:
             else:  # AngleDrive
                 self.drives.append((r0, ks[0], c.profile))
         cl_int, cl_f, law_vec, fric_vec = [], [], [], []
+        film_off, film_spl = [], []  # per joint: offset of its finite film's table, or -1
         for cj in sysm.clearances:
             film = cj.viscosity is not None
+            finite = film and cj.film_model == "finite"
             cl_int.append((key(cj.journal, cj.journal_frame), key(cj.bearing, cj.bearing_frame),
-                           cj.normal.code, cj.friction_law.code, int(film)))
+                           cj.normal.code, cj.friction_law.code, 2 if finite else int(film)))
+            film_off.append(sum(a.size for a in film_spl) if finite else -1)
+            if finite:
+                film_spl.append(film_spline(cj.bearing_length / (2.0 * cj.journal_radius)))
             major = -1.0 if cj.clearance_major is None else cj.clearance_major
             cl_f.append((cj.clearance, cj.journal_radius, cj.v_impact_min, major, cj.wear_angle,
                          cj.viscosity if film else 0.0, cj.bearing_length, cj.eps_max))
@@ -755,12 +765,13 @@ class CompiledSystem:
                 "cl_int": cl_int, "pl_int": pl_int, "gas_off": off, "tq_k": tq_k,
                 "is_drive": sysm._drive_rows, "col_ptr": col_ptr,
                 "col_rows": np.concatenate(col_rows) if col_rows else [],
-                "massless": massless, "fb_int": fb_int, "full": [int(full)]}
+                "massless": massless, "fb_int": fb_int, "full": [int(full)],
+                "film_off": film_off}
         floats = {"floc": floc, "fmodal": fmodal, "mdiag": mdiag, "Q0": Q0,
                   "pri_n": pri_n, "pri_o": pri_o, "pri_ang": pri_ang, "cl_f": cl_f,
                   "law_vec": law_vec, "fric_vec": fric_vec, "pl_f": pl_f, "gas_x": gx,
                   "gas_f": gf, "gas_period": period, "tq_val": tq_val,
-                  "baumgarte": [sysm.baumgarte], "fb_f": fb_f}
+                  "baumgarte": [sysm.baumgarte], "fb_f": fb_f, "film_spl": film_spl}
         self.I, self.io = _pack([_flat(ints[k]) for k in INT_TABLES], np.int64)
         self.F, self.fo = _pack([_flat(floats[k]) for k in FLOAT_TABLES], float)
         self.gas_py = np.zeros(npl)
@@ -879,17 +890,17 @@ def _flush_if_dependencies_changed() -> bool:
     """Flush this module's Numba cache when a module whose jitted functions it calls changed.
 
     Numba keys a cached function on its own file only (numba issue #1833): the kernel calls
-    ``worn_bore_clearance`` (clearance.py) and ``film_arguments``/``short_film``
-    (lubrication.py), so an edit or an upgrade there would otherwise be served the old kernel.
+    ``worn_bore_clearance`` (clearance.py), ``film_arguments``/``short_film``
+    (lubrication.py) and ``finite_film`` (reynolds.py), so an edit or an upgrade there would otherwise be served the old kernel.
     A stamp of those files' bytes kept beside the cache decides; returns whether it flushed.
     """
     import hashlib
     from pathlib import Path
 
-    from . import clearance, lubrication
+    from . import clearance, lubrication, reynolds
 
     digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes()
-                                     for m in (clearance, lubrication))).hexdigest()
+                                     for m in (clearance, lubrication, reynolds))).hexdigest()
     cached = [f for f in globals().values()
               if getattr(f, "_cache", None) is not None and hasattr(f, "py_func")]
     try:

@@ -35,6 +35,7 @@ from functools import lru_cache
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from ..errors import NumericalError
 
@@ -326,22 +327,84 @@ def finite_bearing_force(eps, eps_dot, gamma_dot, omega, viscosity, radius, leng
     return finite_bearing_film(eps, wedge, eps_dot, viscosity, radius, length, clearance)
 
 
+@lru_cache(maxsize=8)
+def film_spline(l_over_d: float) -> np.ndarray:
+    """The film table of one ``L/D`` as one flat array for :func:`finite_film` (and the kernel):
+    ``[n_tx, n_ty, eps_lo, eps_hi, tx..., ty..., c_r..., c_t...]`` — the knots and coefficients
+    of :func:`film_table`'s two bicubic splines (FITPACK's layout, ``c[ix * (n_ty - 4) + iy]``)
+    and the eccentricity range of the table."""
+    f_r, f_t = film_table(round(float(l_over_d), 6))
+    tx, ty, c_r = f_r.tck
+    c_t = f_t.tck[2]
+    if tuple(f_r.degrees) != (3, 3) or not np.array_equal(f_t.tck[0], tx):
+        raise NumericalError("reynolds: the film table's splines are not bicubic on one grid")
+    return np.concatenate([[tx.size, ty.size, EPS_TABLE[0], EPS_TABLE[-1]], tx, ty, c_r, c_t])
+
+
+@njit(cache=True)
+def _cubic_basis(t, x, out):
+    """The four non-zero cubic B-splines of knots ``t`` at ``x`` into ``out``; returns the knot
+    span ``i`` (``t[i] <= x < t[i + 1]``, the last span closed), so that ``out[a]`` belongs to
+    coefficient ``i - 3 + a`` (de Boor's recurrence, as FITPACK's ``fpbspl``)."""
+    n = t.size
+    i = 3
+    while i < n - 5 and x >= t[i + 1]:
+        i += 1
+    left = np.empty(4)
+    right = np.empty(4)
+    out[0] = 1.0
+    for j in range(1, 4):
+        left[j] = x - t[i + 1 - j]
+        right[j] = t[i + j] - x
+        saved = 0.0
+        for r in range(j):
+            temp = out[r] / (right[r + 1] + left[j - r])
+            out[r] = saved + right[r + 1] * temp
+            saved = left[j - r] * temp
+        out[j] = saved
+    return i
+
+
+@njit(cache=True)
+def finite_film(eps, wedge, eps_dot, viscosity, radius, length, clearance, spline):
+    """Finite-bearing film force ``(f_r, f_t)`` on the journal, N, from the table ``spline``
+    (:func:`film_spline`): the one evaluation of the finite film, for the Python path and the
+    compiled kernel. Arguments as :func:`finite_bearing_film`."""
+    ntx, nty = int(spline[0]), int(spline[1])
+    e = min(max(eps, spline[2]), spline[3])
+    s = 1.0 - e * e
+    r = abs(wedge) / s**2
+    q = eps_dot / s**2.5
+    mag = np.hypot(r, q)
+    if mag == 0.0:
+        return 0.0, 0.0
+    a = np.arctan2(q, r)
+    tx = spline[4:4 + ntx]
+    ty = spline[4 + ntx:4 + ntx + nty]
+    ncx, ncy = ntx - 4, nty - 4
+    c0 = 4 + ntx + nty
+    bx = np.empty(4)
+    by = np.empty(4)
+    ix = _cubic_basis(tx, e, bx)
+    iy = _cubic_basis(ty, a, by)
+    fr = ft = 0.0
+    for u in range(4):
+        row = (ix - 3 + u) * ncy + iy - 3
+        for v in range(4):
+            w = bx[u] * by[v]
+            fr += spline[c0 + row + v] * w
+            ft += spline[c0 + ncx * ncy + row + v] * w
+    scale = viscosity * radius * length * (radius / clearance) ** 2 * mag
+    return scale * fr, (scale * ft if wedge >= 0.0 else -scale * ft)
+
+
 def finite_bearing_film(eps, wedge, eps_dot, viscosity, radius, length, clearance):
     """Finite-bearing film force from the wedge ``eps (omega - 2 gamma_dot)`` (1/s), N.
 
     As :func:`finite_bearing_force`, with the arguments of
     :func:`.lubrication.short_bearing_film` (the wedge stays finite at the bearing centre).
+    Evaluated by :func:`finite_film` (the compiled kernel's own evaluation).
     """
-    e = float(min(max(eps, EPS_TABLE[0]), EPS_TABLE[-1]))
-    f_r, f_t = film_table(round(float(length) / (2.0 * radius), 6))
-    s = 1.0 - e * e
-    w = float(wedge)
-    r = abs(w) / s**2
-    q = float(eps_dot) / s**2.5
-    mag = np.hypot(r, q)
-    if mag == 0.0:
-        return 0.0, 0.0
-    a = np.arctan2(q, r)
-    scale = viscosity * radius * length * (radius / clearance) ** 2 * mag
-    ft = scale * float(f_t(e, a, grid=False))
-    return scale * float(f_r(e, a, grid=False)), (ft if w >= 0.0 else -ft)
+    spline = film_spline(float(length) / (2.0 * radius))
+    return finite_film(float(eps), float(wedge), float(eps_dot), float(viscosity), float(radius),
+                       float(length), float(clearance), spline)
