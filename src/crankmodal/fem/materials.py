@@ -33,6 +33,15 @@ class Material:
     yield_strength, ultimate_strength : float or None
         Pa; safety factors need them.
     description : str
+    fatigue_strength : float or None
+        Fully reversed (R = -1) fatigue strength of unnotched, polished specimens, Pa, at
+        ``fatigue_cycles`` (bending or axial, as the library's comment says); the crankshaft
+        fatigue verdict (:mod:`crankmodal.fatigue`) needs it.
+    fatigue_strength_torsion : float or None
+        Fully reversed torsional fatigue strength, Pa; None: derived by von Mises,
+        ``fatigue_strength / sqrt(3)`` (:attr:`torsional_fatigue_strength`).
+    fatigue_cycles : float or None
+        Number of cycles at which the fatigue strengths hold (e.g. 1e7).
 
     Raises
     ------
@@ -49,13 +58,18 @@ class Material:
     yield_strength: float | None = None
     ultimate_strength: float | None = None
     description: str = ""
+    fatigue_strength: float | None = None
+    fatigue_strength_torsion: float | None = None
+    fatigue_cycles: float | None = None
 
     def __post_init__(self):
         import math
         from numbers import Real
 
         for key, optional in (("E", False), ("nu", False), ("rho", False),
-                              ("yield_strength", True), ("ultimate_strength", True)):
+                              ("yield_strength", True), ("ultimate_strength", True),
+                              ("fatigue_strength", True), ("fatigue_strength_torsion", True),
+                              ("fatigue_cycles", True)):
             v = getattr(self, key)
             if v is None and optional:
                 continue
@@ -69,10 +83,14 @@ class Material:
         ):
             if not ok:
                 raise ParameterError(key, f"must be {text}, got {value!r} ({self.name})")
-        for key in ("yield_strength", "ultimate_strength"):
+        for key in ("yield_strength", "ultimate_strength", "fatigue_strength",
+                    "fatigue_strength_torsion"):
             v = getattr(self, key)
             if v is not None and not v > 0:
                 raise ParameterError(key, f"must be > 0 Pa, got {v!r} ({self.name})")
+        if self.fatigue_cycles is not None and not self.fatigue_cycles >= 1:
+            raise ParameterError("fatigue_cycles", f"must be >= 1, got {self.fatigue_cycles!r} "
+                                                   f"({self.name})")
 
     @property
     def lame(self) -> tuple[float, float]:
@@ -84,11 +102,24 @@ class Material:
         """G = E / (2 (1 + ν)), Pa."""
         return self.E / (2.0 * (1.0 + self.nu))
 
+    @property
+    def torsional_fatigue_strength(self) -> float | None:
+        """Fully reversed torsional fatigue strength, Pa: ``fatigue_strength_torsion`` if given,
+        else the von Mises value ``fatigue_strength / sqrt(3)``; None without fatigue data."""
+        if self.fatigue_strength_torsion is not None:
+            return self.fatigue_strength_torsion
+        if self.fatigue_strength is None:
+            return None
+        return self.fatigue_strength / 3.0 ** 0.5
+
     def to_dict(self) -> dict:
         return {
             "name": self.name, "E_pa": self.E, "nu": self.nu, "rho_kg_m3": self.rho,
             "yield_strength_pa": self.yield_strength,
             "ultimate_strength_pa": self.ultimate_strength,
+            "fatigue_strength_pa": self.fatigue_strength,
+            "fatigue_strength_torsion_pa": self.torsional_fatigue_strength,
+            "fatigue_cycles": self.fatigue_cycles,
             "description": self.description,
         }
 

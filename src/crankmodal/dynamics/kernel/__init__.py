@@ -1,0 +1,1 @@
+"""The compiled evaluator (Numba) of a built system, and the compiled integrator loop."""

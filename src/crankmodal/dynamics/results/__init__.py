@@ -1,0 +1,1 @@
+"""What a run gives: sampled histories, signals, per-revolution statistics, validity checks and figures."""

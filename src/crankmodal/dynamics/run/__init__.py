@@ -1,0 +1,1 @@
+"""Running a mechanism: the integrator driver, checked runs, run budgets, contact time scales and ensembles."""
