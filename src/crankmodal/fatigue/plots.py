@@ -55,8 +55,10 @@ def plot_safety(result, path=None):
     hx.plot([-su, 0.0], [se, se], color="black", lw=1.5, ls="--",
             label="compressive mean: no credit")
     for k, name in enumerate(names):
-        hx.plot(locs[name]["mean_pa"] / 1e6, locs[name]["alternating_pa"] / 1e6, "o",
-                color=colours[k], ms=5)
+        xy = (locs[name]["mean_pa"] / 1e6, locs[name]["alternating_pa"] / 1e6)
+        hx.plot(*xy, "o", color=colours[k], ms=5)
+        hx.annotate(name.replace("_", " "), xy, xytext=(4, 2 + 7 * (k % 3)),
+                    textcoords="offset points", fontsize=6)
     hx.set_xlabel("equivalent mean stress, MPa")
     hx.set_ylabel("equivalent alternating stress, MPa")
     hx.set_title("Haigh diagram (K_f applied to the stresses)", fontsize=10)
