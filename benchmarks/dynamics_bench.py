@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 
 from crankmodal.dynamics import Cylinder, SolverSettings, crank_train
-from crankmodal.dynamics.analysis import simulate
-from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.signals import impact_statistics
-from crankmodal.dynamics.simulate import integrate
+from crankmodal.dynamics.results.signals import impact_statistics
+from crankmodal.dynamics.run.integrate import integrate
+from crankmodal.dynamics.run.simulate import simulate
+from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
 
@@ -87,7 +87,7 @@ def four_star_run(t_end=1.0, compiled=True, rtol_factor=1.0):
     wall = time.perf_counter() - t0
     st = impact_statistics(h.onsets["big_end_1"])
     # the converged per-revolution statistics (dynamics.statistics) after the ramp + 1 rev
-    from crankmodal.dynamics.stats import statistics
+    from crankmodal.dynamics.results.stats import statistics
 
     rs = statistics(h, mech.revolution_hz, p["ramp_time"] + 1.0 / mech.revolution_hz)
     mb = rs["main_bearing_force"]

@@ -15,9 +15,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import crankmodal as cm
-from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.reynolds import steady_bearing
-from crankmodal.dynamics.signals import force_direction
+from crankmodal.dynamics.laws.reynolds import steady_bearing
+from crankmodal.dynamics.results.signals import force_direction
+from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
 
 
 def table(rows, header):

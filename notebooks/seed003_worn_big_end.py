@@ -22,8 +22,8 @@ import numpy as np
 from IPython.display import Image, display
 
 import crankmodal as cm
-from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.signals import impact_statistics
+from crankmodal.dynamics.results.signals import impact_statistics
+from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
 
 OUT = Path(tempfile.mkdtemp(prefix="seed003_"))
 SCENE = cm.scene_path("slider_crank_dynamics")

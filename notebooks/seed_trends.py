@@ -28,10 +28,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import crankmodal as cm
-from crankmodal.dynamics.analysis import simulate
-from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.reynolds import steady_bearing
-from crankmodal.dynamics.signals import (
+from crankmodal.dynamics.laws.reynolds import steady_bearing
+from crankmodal.dynamics.results.signals import (
     amplitude_spectrum,
     contact_loss_indicator,
     force_direction,
@@ -39,7 +37,9 @@ from crankmodal.dynamics.signals import (
     order_amplitudes,
     window_peaks,
 )
-from crankmodal.dynamics.simulate import integrate
+from crankmodal.dynamics.run.integrate import integrate
+from crankmodal.dynamics.run.simulate import simulate
+from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
 

@@ -41,7 +41,7 @@ def test_every_exported_name_resolves_to_its_home_module_object():
 def test_star_import_gives_the_public_names_and_an_unknown_name_is_an_attribute_error():
     out = _fresh("from crankmodal import *; import json; "
                  "print(json.dumps([solve_modes.__module__, Part.__name__, simulate.__module__]))")
-    assert json.loads(out) == ["crankmodal.fem.modal", "Part", "crankmodal.dynamics.analysis"]
+    assert json.loads(out) == ["crankmodal.fem.modal", "Part", "crankmodal.dynamics.run.simulate"]
     with pytest.raises(AttributeError, match="no attribute 'no_such_thing'"):
         crankmodal.no_such_thing  # noqa: B018
 
@@ -49,9 +49,9 @@ def test_star_import_gives_the_public_names_and_an_unknown_name_is_an_attribute_
 def test_the_core_objects_the_readme_composes_are_the_expected_kinds():
     # a name bound to the wrong object (e.g. the reduced .npz body where the multibody body is
     # meant) would still resolve; the two flexible-body types are distinct on purpose
-    assert crankmodal.FlexibleBody.__module__ == "crankmodal.dynamics.flexible"
+    assert crankmodal.FlexibleBody.__module__ == "crankmodal.dynamics.flexible.body"
     assert crankmodal.ReducedBody.__module__ == "crankmodal.reduction.flexbody"
-    assert crankmodal.Cylinder.__module__ == "crankmodal.dynamics.mechanisms"
+    assert crankmodal.Cylinder.__module__ == "crankmodal.dynamics.model.mechanisms"
     # the geometric cylinder (a bore or journal surface) is the other "cylinder"
     assert crankmodal.CylindricalSurface.__module__ == "crankmodal.part"
     assert crankmodal.CylindricalSurface is not crankmodal.Cylinder

@@ -245,7 +245,7 @@ def test_the_memory_refusal_says_how_many_samples_and_which_step_fits(rigid):
 
 
 def test_the_missing_stiffness_message_gives_the_scene_default_from_the_radii():
-    from crankmodal.dynamics.contact import cylinder_stiffness
+    from crankmodal.dynamics.laws.contact import cylinder_stiffness
 
     with pytest.raises(ParameterError) as info:
         mech(clearances={"main": {"clearance": 1e-4, "journal_radius": 0.02}})
@@ -290,8 +290,8 @@ def test_crank_train_without_roles_uses_the_frames_crank_body_names(bar_crank):
 
 
 def test_solver_settings_default_is_auto_and_simulate_decides_it_as_the_scene_does(bar_crank):
-    from crankmodal.dynamics.analysis import resolved
-    from crankmodal.dynamics.simulate import auto_method
+    from crankmodal.dynamics.run.integrate import auto_method
+    from crankmodal.dynamics.run.simulate import resolved
 
     assert cm.SolverSettings().method == "auto"
     rigid = mech()

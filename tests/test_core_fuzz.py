@@ -549,7 +549,7 @@ def flexbody_file(tmp_path_factory):
     folder = tmp_path_factory.mktemp("flexbody")
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("CRANKMODAL_CACHE", str(folder / "cache"))
-        from crankmodal.dynamics.flexbuild import reduced_bar
+        from crankmodal.dynamics.flexible.build import reduced_bar
 
         path = reduced_bar(0.075, (0.05, 0.077), {"mesh_size": 0.025, "element_order": 1,
                                                   "material": "steel", "fixed_interface_modes": 4},
@@ -645,7 +645,7 @@ BAD_ARGUMENTS = ["fuzz", None, [1.0], {"a": 1}, math.nan, math.inf, -1, 0, 1e30,
 
 def api_calls():
     """name -> (function, keyword arguments that work); each argument is mutated alone."""
-    from crankmodal.dynamics.flexbuild import reduced_bar
+    from crankmodal.dynamics.flexible.build import reduced_bar
     from crankmodal.fem.testparts import bar, check_bar_size
     from crankmodal.geometry import ConrodParams, MeshSettings, build_part
     from crankmodal.geometry.importers import import_mesh

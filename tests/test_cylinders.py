@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from crankmodal import part
-from crankmodal.dynamics.bridge import cylinders_from_mechanism
-from crankmodal.dynamics.mechanisms import Cylinder
+from crankmodal.dynamics.model.bridge import cylinders_from_mechanism
+from crankmodal.dynamics.model.mechanisms import Cylinder
 from crankmodal.errors import ParameterError
 from crankmodal.mechanism import machine as mm
 

@@ -32,7 +32,7 @@ DOCTEST_MODULES = (
     "crankmodal.torsion.chain",
     "crankmodal.torsion.holzer",
     "crankmodal.torsion.two_rotor",
-    "crankmodal.dynamics.laws",
+    "crankmodal.dynamics.laws.objects",
     "crankmodal.fem.modal",
 )
 #: public names that must carry an executed Examples section

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from crankmodal.dynamics import contact
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import AUX_NAMES, Multibody
+from crankmodal.dynamics.laws import contact
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import AUX_NAMES, Multibody
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 
 MASS = 2.0
 CLEARANCE = 1e-4
@@ -156,7 +156,7 @@ def test_worn_bore_contact_on_a_spinning_bearing_conserves_energy():
     ground = Ground(frames={"o": (0.0, 0.0)})
     ring = RigidBody("ring", 3.0, 2e-3, {"bore": (0.0, 0.0)})
     journal = RigidBody("journal", MASS, 1e-3, {"centre": (0.0, 0.0)})
-    from crankmodal.dynamics.joints import Revolute
+    from crankmodal.dynamics.model.joints import Revolute
 
     joint = ClearanceJoint("c", journal, "centre", ring, "bore", clearance=1e-4,
                            clearance_major=4e-4, wear_angle=0.3, journal_radius=0.01,
@@ -175,7 +175,7 @@ def test_worn_bore_contact_on_a_spinning_bearing_conserves_energy():
 def test_impact_statistics_counts_a_bouncing_ball_by_velocity_and_by_flight_time():
     # closed form: a ball dropped onto a rigid floor at v0 with restitution e lands at
     # v_k = e^k v0 after flights 2 v_{k-1} / g; the contact itself takes no time
-    from crankmodal.dynamics.signals import impact_statistics
+    from crankmodal.dynamics.results.signals import impact_statistics
 
     g, v0, e = 9.81, 2.0, 0.8
     v = v0 * e ** np.arange(30)

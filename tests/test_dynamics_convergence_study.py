@@ -7,7 +7,7 @@ The oracle of the verdicts is arithmetic on the synthetic values, done here by h
 
 import pytest
 
-from crankmodal.dynamics.analysis import convergence_line, statistics_convergence
+from crankmodal.dynamics.run.simulate import convergence_line, statistics_convergence
 
 RTOLS = [1e-5, 1e-6, 1e-7]
 
@@ -83,7 +83,7 @@ def test_a_study_row_is_the_run_that_set_rtol_gives(tmp_path, monkeypatch):
     scene run with ``--set dynamics.solver.rtol=1e-8``: the same atol (its default follows the
     clearance, not rtol), method and step bound. Before, the study scaled atol with rtol (1e-11
     here instead of 1e-9)."""
-    from crankmodal.dynamics import analysis
+    from crankmodal.dynamics.run import simulate as analysis
     from crankmodal.runner import run
     from crankmodal.scene import scene_from_dict
 

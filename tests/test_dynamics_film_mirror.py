@@ -12,12 +12,12 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.lubrication import short_bearing_force
-from crankmodal.dynamics.reynolds import solve_pressure
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.laws.lubrication import short_bearing_force
+from crankmodal.dynamics.laws.reynolds import solve_pressure
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import Multibody
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 from crankmodal.runner import run
 from crankmodal.scene import scene_from_dict
 

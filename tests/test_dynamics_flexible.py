@@ -8,12 +8,12 @@ import pytest
 import scipy.linalg as sla
 from conftest import peak_hz
 
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.flexible import FlexibleBody, load_flexible_body
-from crankmodal.dynamics.history import record
-from crankmodal.dynamics.joints import Revolute
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import N_AUX, Multibody
+from crankmodal.dynamics.flexible.body import FlexibleBody, load_flexible_body
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.joints import Revolute
+from crankmodal.dynamics.model.system import N_AUX, Multibody
+from crankmodal.dynamics.results.history import record
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 from crankmodal.errors import CrankmodalError, InputFileError, SceneError
 from crankmodal.fem.assembly import assemble
 from crankmodal.fem.materials import Material
@@ -235,7 +235,7 @@ def test_cutoff_selects_in_plane_modes_and_reports_what_the_plane_drops(reduced)
 
 
 def test_rigid_and_flexible_bodies_implement_the_body_protocol(reduced):
-    from crankmodal.dynamics.bodies import Body
+    from crankmodal.dynamics.model.bodies import Body
 
     flex = load_flexible_body(reduced.path, "bar", n_modes=2)
     assert isinstance(flex, Body) and isinstance(RigidBody("r", 1.0, 1.0), Body)

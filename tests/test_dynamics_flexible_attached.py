@@ -13,12 +13,12 @@ import pytest
 import scipy.linalg as sla
 from test_dynamics_flexible_fourbar import BARS, LOOM, SPEC, fe_bar
 
-from crankmodal.dynamics import flexbuild
-from crankmodal.dynamics.analysis import simulate
-from crankmodal.dynamics.bodies import RigidBody
-from crankmodal.dynamics.flexible import FlexibleBody
-from crankmodal.dynamics.mechanisms import four_bar
-from crankmodal.dynamics.simulate import SolverSettings
+from crankmodal.dynamics.flexible import build as flexbuild
+from crankmodal.dynamics.flexible.body import FlexibleBody
+from crankmodal.dynamics.model.bodies import RigidBody
+from crankmodal.dynamics.model.mechanisms import four_bar
+from crankmodal.dynamics.run.integrate import SolverSettings
+from crankmodal.dynamics.run.simulate import simulate
 
 SLEY = LOOM["extra_rocker_inertia"]  # kg m², about D
 
@@ -191,7 +191,7 @@ def test_rocker_pinned_at_both_ends_swings_the_sley_on_its_bending_stiffness(ora
 def _quasi_static_bending(rocker, extra, crank_deg):
     """The loom at 450 rpm, quasi-static start at ``crank_deg``: the rocker's bending deflection
     of C off D's tangent (body axes, m) and the coupler's force on it across its axis at C, N."""
-    from crankmodal.dynamics.initial import quasi_static_start
+    from crankmodal.dynamics.flexible.initial import quasi_static_start
 
     m = four_bar(**dict(LOOM, extra_rocker_inertia=extra, theta0=np.deg2rad(crank_deg)),
                  rocker_body=rocker)

@@ -9,11 +9,11 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from crankmodal.dynamics import flexbuild
-from crankmodal.dynamics.analysis import simulate
-from crankmodal.dynamics.bodies import RigidBody
-from crankmodal.dynamics.mechanisms import four_bar
-from crankmodal.dynamics.simulate import SolverSettings
+from crankmodal.dynamics.flexible import build as flexbuild
+from crankmodal.dynamics.model.bodies import RigidBody
+from crankmodal.dynamics.model.mechanisms import four_bar
+from crankmodal.dynamics.run.integrate import SolverSettings
+from crankmodal.dynamics.run.simulate import simulate
 from crankmodal.errors import ParameterError, SceneError
 
 LOOM = {"crank_length": 0.035, "coupler_length": 0.075, "rocker_length": 0.145,
@@ -122,7 +122,7 @@ def test_slow_four_bar_under_gravity_stretches_the_coupler_as_the_static_fe(bars
     heavy modal damping: its elongation between the pins from the modal coordinates equals the
     full FE static solve of the bar under the joint force at C (the force of the run) and its
     own weight, to 1 % (and F L / (E A) to 2 %)."""
-    from crankmodal.dynamics.initial import quasi_static_start
+    from crankmodal.dynamics.flexible.initial import quasi_static_start
 
     g = np.array([0.0, -9.81])
     coupler = _link(bars, "coupler", damping_ratio=0.7)  # every stored in-plane mode
@@ -149,7 +149,7 @@ def test_quasi_static_start_loads_a_stiff_coupler_at_once(bars):
     the quasi-static start its joints carry the rigid twin's forces at t = 0 (to 1e-3 of the
     peak). Scaled by ω², the undeformed state already looked converged to the old test (1e-9)
     while the joints carried 30 N of the rigid 1 400 N, and the run rang at 650 kN."""
-    from crankmodal.dynamics.initial import quasi_static_start
+    from crankmodal.dynamics.flexible.initial import quasi_static_start
 
     spec = dict(SPEC, mesh_size=0.025, fixed_interface_modes=6)
     path = flexbuild.reduced_bar(0.075, (0.05, 0.077), spec, "dynamics.flexible.coupler")
@@ -192,7 +192,7 @@ def test_quasi_static_start_with_the_seed_clearance_at_c_starts_centred(tmp_path
 
 
 def test_a_truncated_rocker_carrying_the_sley_is_warned_and_a_complete_one_not(bars):
-    from crankmodal.dynamics.flexstage import truncation_warnings
+    from crankmodal.dynamics.scene.flexstage import truncation_warnings
 
     p = {"mechanism": "four_bar", "four_bar": {"extra_rocker_inertia": 0.3728}}
     stored = len(_link(bars, "rocker").left_out()["offered_hz"])
@@ -214,7 +214,7 @@ def test_link_bodies_at_the_wrong_length_or_without_their_frames_are_refused(bar
     with pytest.raises(ParameterError, match=r"^interfaces: .*no interface 'pin'"):
         flexbuild.link_body(bars.rocker, dict(SPEC, interfaces=["end_x0", "pin"]), 0.145,
                             "rocker")
-    from crankmodal.dynamics.flexstage import body_keys
+    from crankmodal.dynamics.scene.flexstage import body_keys
 
     with pytest.raises(SceneError, match=r"^dynamics.flexible.coupler.file: .*coupler length is "
                                          r"0.08 m"), body_keys("coupler"):
@@ -375,7 +375,7 @@ def test_four_bar_figure_draws_joints_a_to_d_flexible_rigid_and_difference(bars,
     (N) equal to that of the arrays in dynamics.npz over the last revolution drawn."""
     from conftest import run_in_process
 
-    from crankmodal.dynamics import flexplots
+    from crankmodal.dynamics.results import flexplots
 
     drawn = {}
     save = flexplots._save

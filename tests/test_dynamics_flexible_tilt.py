@@ -9,11 +9,11 @@ import pytest
 import scipy.linalg as sla
 from conftest import peak_hz
 
-from crankmodal.dynamics.bodies import Ground
-from crankmodal.dynamics.flexible import load_flexible_body
-from crankmodal.dynamics.joints import Revolute
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.flexible.body import load_flexible_body
+from crankmodal.dynamics.model.bodies import Ground
+from crankmodal.dynamics.model.joints import Revolute
+from crankmodal.dynamics.model.system import Multibody
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 from crankmodal.fem.assembly import assemble
 from crankmodal.fem.materials import Material
 from crankmodal.fem.testparts import bar

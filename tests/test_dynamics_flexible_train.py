@@ -7,12 +7,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from crankmodal.dynamics import flexbuild
-from crankmodal.dynamics.analysis import simulate
-from crankmodal.dynamics.bodies import RigidBody
-from crankmodal.dynamics.bridge import cylinders_from_mechanism
-from crankmodal.dynamics.mechanisms import crank_train
-from crankmodal.dynamics.simulate import SolverSettings
+from crankmodal.dynamics.flexible import build as flexbuild
+from crankmodal.dynamics.model.bodies import RigidBody
+from crankmodal.dynamics.model.bridge import cylinders_from_mechanism
+from crankmodal.dynamics.model.mechanisms import crank_train
+from crankmodal.dynamics.run.integrate import SolverSettings
+from crankmodal.dynamics.run.simulate import simulate
 
 SPEC_CRANK = {"fidelity": "full", "mesh_size": 0.022, "element_order": 2,
               "material": "crank_steel_seed000", "fixed_interface_modes": 16, "n_modes": 6,
@@ -161,8 +161,8 @@ def test_slow_crank_under_a_constant_piston_load_deflects_the_rod_as_the_static_
     under the rod force F / cos(beta): 148.02 µm both, 5e-7 apart (the Craig-Bampton basis
     holds the static response to interface loads exactly; the issue asks <= 1 %); and the
     dynamic stress from the stored stress modes equals that solve's largest von Mises."""
-    from crankmodal.dynamics.flexstage import dynamic_stress
-    from crankmodal.dynamics.mechanisms import Cylinder
+    from crankmodal.dynamics.model.mechanisms import Cylinder
+    from crankmodal.dynamics.scene.flexstage import dynamic_stress
 
     F = 2.0e4
     rod = flexbuild.rod_body(parts.rod, dict(SPEC_ROD, n_modes=None, damping_ratio=0.7),
@@ -189,7 +189,7 @@ def test_slow_crank_under_a_constant_piston_load_deflects_the_rod_as_the_static_
 
 
 def _flex_scene(tmp_path, crank=None, rods=None):
-    from crankmodal.dynamics.flexbuild import flexbody_cache_dir  # noqa: F401 (the cache dir)
+    from crankmodal.dynamics.flexible.build import flexbody_cache_dir  # noqa: F401 (the cache dir)
 
     lines = ['name = "flex_bad"', "[mechanism]", 'machine = "four_star_compressor"',
              "[dynamics]", 'machine = "four_star_compressor"', "clearances = []",
@@ -260,8 +260,8 @@ def test_bad_flexible_input_exits_2_with_one_line_naming_the_key(parts, tmp_path
 def test_redundant_journals_are_refused_before_the_run(parts):
     """A crank held at two journals without its tilts and with no elastic mode: four joint
     equations on two coordinates' worth of freedom; refused by name, not a singular solve."""
-    from crankmodal.dynamics.flexible import load_flexible_body
-    from crankmodal.dynamics.mechanisms import RedundantJoints
+    from crankmodal.dynamics.flexible.body import load_flexible_body
+    from crankmodal.dynamics.model.mechanisms import RedundantJoints
 
     crank, roles = flexbuild.crank_body(parts.crank, dict(SPEC_CRANK, n_modes=0), parts.rows,
                                         parts.radius)
@@ -278,7 +278,7 @@ def test_quasi_static_start_removes_the_start_up_ringing(parts):
     start-up blow of ~100x its running force; from the quasi-static state (elastic
     accelerations zero at t = 0, joints closed) the force stays at its running level and the
     run needs far fewer evaluations."""
-    from crankmodal.dynamics.initial import quasi_static_start
+    from crankmodal.dynamics.flexible.initial import quasi_static_start
 
     crank, roles, rods = _flex(parts, 4, 2)
     for c in parts.cylinders:

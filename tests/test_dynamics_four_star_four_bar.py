@@ -10,7 +10,7 @@ from crankmodal.dynamics import (
     four_bar,
     simulate,
 )
-from crankmodal.dynamics.signals import order_amplitudes, whirl_components
+from crankmodal.dynamics.results.signals import order_amplitudes, whirl_components
 
 RPM = 1480.0
 W = RPM * np.pi / 30
@@ -111,7 +111,7 @@ def test_loom_four_bar_drive_torque_equals_the_rate_of_kinetic_energy():
 
 def test_loom_coupler_pin_clearance_orbit_stays_near_the_clearance_circle():
     # Seed 001 Table 2 bearing: R = 20 mm, c = 0.021 mm; dry contact, steel stiffness from E.
-    from crankmodal.dynamics.contact import cylinder_stiffness
+    from crankmodal.dynamics.laws.contact import cylinder_stiffness
 
     K = float(cylinder_stiffness(0.02, 0.020021, 2.1e11, 0.3, 2.1e11, 0.3))
     contact = {"law": "lankarani_nikravesh",

@@ -13,11 +13,11 @@ friction angle atan(mu_d) and adds no damping to the rocking mode.
 import numpy as np
 import pytest
 
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.signals import window_peaks
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import Multibody
+from crankmodal.dynamics.results.signals import window_peaks
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 
 MASS, G, C, K, N = 2.0, 1500.0, 1e-4, 1.581e10, 1.5  # kg, m/s^2, m, N/m^1.5, -
 TABLE4_FRICTION = {"mu_static": 0.05, "mu_dynamic": 0.08, "v_static": 1e-4, "v_dynamic": 1e-2}

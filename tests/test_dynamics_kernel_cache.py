@@ -12,8 +12,10 @@ import textwrap
 def test_a_changed_dependency_stamp_flushes_the_kernel_cache(tmp_path):
     code = textwrap.dedent("""
         import hashlib, pathlib
-        import crankmodal.dynamics.compiled as c
-        from crankmodal.dynamics import clearance, lubrication, reynolds
+        import crankmodal.dynamics.kernel.compiled as c
+        from crankmodal.dynamics.model import clearance
+        from crankmodal.dynamics.laws import lubrication
+        from crankmodal.dynamics.laws import reynolds
         cached = [f for f in vars(c).values()
                   if getattr(f, "_cache", None) is not None and hasattr(f, "py_func")]
         stamp = pathlib.Path(cached[0]._cache._cache_path) / "compiled.deps"

@@ -1,12 +1,13 @@
-"""Contact and friction laws as objects (crankmodal.dynamics.laws) against their closed forms,
-the pure functions of crankmodal.dynamics.contact, and the registry round trip."""
+"""Contact and friction laws as objects (crankmodal.dynamics.laws.objects) against their closed forms,
+the pure functions of crankmodal.dynamics.laws.contact, and the registry round trip."""
 
 import numpy as np
 import pytest
 
-from crankmodal.dynamics import contact, laws
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
+from crankmodal.dynamics.laws import contact
+from crankmodal.dynamics.laws import objects as laws
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
 
 DELTA = np.array([-1e-6, 0.0, 1e-7, 3e-6, 2e-5, 8e-5])
 RATE = np.array([0.3, -0.2, 0.5, -0.4, 1.2, -2.0])
@@ -133,7 +134,7 @@ def test_clearance_joint_takes_names_or_objects_alike():
                                                                restitution=0.5)).needs_memory
 
 
-# --- what the contact time scales ask of a law (crankmodal.dynamics.timescales) ---------------
+# --- what the contact time scales ask of a law (crankmodal.dynamics.run.timescales) ---------------
 
 LOADS = (40.0, 3e3, 1e5)  # N; Johnson's approach is valid below 4 K dR e**-3 = 6e5 N here
 

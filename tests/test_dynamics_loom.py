@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from crankmodal.dynamics import SolverSettings, four_bar, simulate
-from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.signals import force_direction
+from crankmodal.dynamics.results.signals import force_direction
+from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
 

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.lubrication import attitude_angle, short_bearing_force
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import AUX_NAMES, Multibody
+from crankmodal.dynamics.laws.lubrication import attitude_angle, short_bearing_force
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import AUX_NAMES, Multibody
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 
 MU, R, L, C = 0.0175, 0.02, 0.042, 2.1e-5   # seed 001 Table 2
 

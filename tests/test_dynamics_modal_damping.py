@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from crankmodal.dynamics.flexible import FlexibleBody
-from crankmodal.dynamics.modal_damping import effective_damping
+from crankmodal.dynamics.flexible.body import FlexibleBody
+from crankmodal.dynamics.flexible.modal_damping import effective_damping
 
 N_MODES = 10
 X = np.linspace(0.0, 1.0, 20001)
@@ -98,7 +98,7 @@ def test_a_crank_is_held_at_its_main_journals_only_and_overconstrained_bodies_gi
     """A crank's crankpins carry the light rods: only its main journals are held (here the
     beam's end0 as the main journal, end1 as the pin: the pinned-free mode). Holding more
     coordinates than the body has (three pins on a 1-mode body) leaves no mode: None."""
-    from crankmodal.dynamics.modal_damping import pinned_interfaces
+    from crankmodal.dynamics.flexible.modal_damping import pinned_interfaces
 
     body, *_ = _beam(0.02)
     body.info["roles"] = {"mains": ["end0"], "pins": ["end1"], "drive": "end0"}
@@ -125,11 +125,11 @@ def test_struck_pinned_beam_decays_at_the_effective_ratio_in_the_multibody_simul
     import scipy.linalg as sla
     from scipy.signal import find_peaks
 
-    from crankmodal.dynamics.bodies import Ground
-    from crankmodal.dynamics.joints import Revolute
-    from crankmodal.dynamics.modal_damping import constrained_matrices
-    from crankmodal.dynamics.simulate import SolverSettings, integrate
-    from crankmodal.dynamics.system import Multibody
+    from crankmodal.dynamics.flexible.modal_damping import constrained_matrices
+    from crankmodal.dynamics.model.bodies import Ground
+    from crankmodal.dynamics.model.joints import Revolute
+    from crankmodal.dynamics.model.system import Multibody
+    from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 
     body, *_ = _beam(0.02)
 

@@ -13,17 +13,17 @@ import numpy as np
 import pytest
 from conftest import SCENES, run_cli
 
-from crankmodal.dynamics import budget
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.simulate import SolverSettings
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import Multibody
+from crankmodal.dynamics.run import budget
+from crankmodal.dynamics.run.integrate import SolverSettings
 from crankmodal.errors import ParameterError
 
 
 def _scene_mech(scene, *overrides, end_time=None):
     """Mechanism, solver settings, end time and output step of a rigid-body scene."""
-    from crankmodal.dynamics.build import build_mechanism, solver_settings
+    from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
     from crankmodal.runner import check
     from crankmodal.scene import load_scene
 
@@ -51,7 +51,7 @@ def test_four_star_damping_1e9_is_refused_before_the_run_naming_contact_damping(
 
 
 def test_python_api_simulate_refuses_damping_1e9_before_integrating(monkeypatch):
-    from crankmodal.dynamics import analysis
+    from crankmodal.dynamics.run import simulate as analysis
 
     mech, settings, t_end, dt = _scene_mech("four_star_dynamics.toml",
                                             "dynamics.contact.damping=1e9")
@@ -146,7 +146,7 @@ def test_over_three_times_the_budget_is_refused_and_over_a_fifth_is_warned():
 
 
 def _measured_against_estimate(scene, t_end, *overrides):
-    from crankmodal.dynamics.analysis import simulate
+    from crankmodal.dynamics.run.simulate import simulate
 
     mech, settings, _, dt = _scene_mech(scene, *overrides)
     est = budget.estimate(mech, t_end, settings)
@@ -186,8 +186,8 @@ def test_default_scenes_are_neither_refused_nor_warned(scene):
 
 # ---------------------------------------------------------------- the guard
 def test_an_early_stop_says_when_the_steps_fell_far_below_the_contact_time_scales():
-    from crankmodal.dynamics.laws import KelvinVoigt
-    from crankmodal.dynamics.timescales import TimeScale
+    from crankmodal.dynamics.laws.objects import KelvinVoigt
+    from crankmodal.dynamics.run.timescales import TimeScale
 
     # K = 1e8 N/m on 2 kg: the contact period allows steps of 2 sqrt(m / K) = 2.8e-4 s
     ts = TimeScale("c", 2.0, 100.0, 1e8, 2 * np.pi * np.sqrt(2e-8), None, None,

@@ -7,16 +7,16 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from crankmodal.dynamics import SolverSettings, four_bar, simulate
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.lubrication import short_bearing_force
-from crankmodal.dynamics.reynolds import (
+from crankmodal.dynamics.laws.lubrication import short_bearing_force
+from crankmodal.dynamics.laws.reynolds import (
     finite_bearing_force,
     solve_pressure,
     steady_bearing,
 )
-from crankmodal.dynamics.simulate import integrate
-from crankmodal.dynamics.system import AUX_NAMES, Multibody
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import AUX_NAMES, Multibody
+from crankmodal.dynamics.run.integrate import integrate
 
 MU, R, L, C = 0.0175, 0.02, 0.042, 2.1e-5   # seed 001 Table 2 (L/D = 1.05)
 EPS = (0.2, 0.5, 0.8)
@@ -166,7 +166,7 @@ def test_tabulated_dynamic_film_force_equals_a_direct_solve_with_squeeze(eps, ep
 def _off_node_points(n, seed):
     """(eps, alpha) drawn between the table's nodes: eps in [0.05, 0.95], alpha in
     (-pi/2, pi/2); the first three are steady (alpha = 0, no squeeze)."""
-    from crankmodal.dynamics.reynolds import ALPHA_TABLE, EPS_TABLE
+    from crankmodal.dynamics.laws.reynolds import ALPHA_TABLE, EPS_TABLE
 
     rng = np.random.default_rng(seed)
     pts = []
@@ -180,7 +180,7 @@ def _off_node_points(n, seed):
 
 
 def _film_within_half_percent_and_0p3_deg_off_the_nodes(l_over_d, n, seed):
-    from crankmodal.dynamics.reynolds import film_table
+    from crankmodal.dynamics.laws.reynolds import film_table
 
     f_r, f_t = film_table(l_over_d)
     worst = [0.0, 0.0]
@@ -247,7 +247,7 @@ def test_loaded_spinning_journal_settles_at_the_steady_finite_bearing_equilibriu
 def test_lubricated_loom_coupler_pin_with_finite_film_closes_its_energy_balance():
     # Seed 001 loom four-bar at 450 rpm, coupler pin C lubricated (Table 2 bearing): the
     # film carries the pin load (no dry contact) and the energy residual stays < 1e-4.
-    from crankmodal.dynamics.contact import cylinder_stiffness
+    from crankmodal.dynamics.laws.contact import cylinder_stiffness
 
     loom = {"crank_length": 0.035, "coupler_length": 0.075, "rocker_length": 0.145,
                 "rocker_pivot": (0.008, 0.1598), "masses": (35.8, 2.27, 10.42),
@@ -282,7 +282,7 @@ def test_a_damaged_cached_film_table_is_solved_again_with_one_warning(tmp_path, 
     # a small table (2 x 3 nodes, 16 x 4 grid) keeps this quick; the cache logic is the same
     import warnings
 
-    from crankmodal.dynamics import reynolds
+    from crankmodal.dynamics.laws import reynolds
     from crankmodal.errors import ModelWarning
 
     monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path))
@@ -312,7 +312,7 @@ def test_the_compiled_film_evaluation_equals_fitpack_on_the_table_splines():
     # finite_film (Numba, the one evaluation for the Python path and the kernel) against
     # scipy's RectBivariateSpline (FITPACK bispev) of the same table, with the homogeneous
     # scaling written out here: 1e-12 of the force (measured 1.3e-15)
-    from crankmodal.dynamics.reynolds import EPS_TABLE, film_spline, film_table, finite_film
+    from crankmodal.dynamics.laws.reynolds import EPS_TABLE, film_spline, film_table, finite_film
 
     ld = L / (2 * R)
     f_r, f_t = film_table(ld)

@@ -5,17 +5,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from crankmodal.dynamics.analysis import simulate
-from crankmodal.dynamics.build import build_mechanism, solver_settings
-from crankmodal.dynamics.reynolds import steady_bearing
-from crankmodal.dynamics.signals import (
+from crankmodal.dynamics.laws.reynolds import steady_bearing
+from crankmodal.dynamics.results.signals import (
     amplitude_spectrum,
     force_direction,
     impact_statistics,
     order_amplitudes,
     window_peaks,
 )
-from crankmodal.dynamics.simulate import integrate
+from crankmodal.dynamics.run.integrate import integrate
+from crankmodal.dynamics.run.simulate import simulate
+from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
 from crankmodal.runner import check
 from crankmodal.scene import load_scene
 
@@ -28,7 +28,7 @@ def _run(scene, overrides, dt=None, ideal=False, trajectory=0):
     perturbed as the k-th trajectory of ``dynamics.ensemble`` (relative k x 1e-12)."""
     from dataclasses import replace
 
-    from crankmodal.dynamics.ensemble import EPS
+    from crankmodal.dynamics.run.ensemble import EPS
 
     params = check(load_scene(SCENES / scene, overrides))
     p = params["dynamics"]

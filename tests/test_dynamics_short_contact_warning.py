@@ -5,10 +5,10 @@ instead of reading law names and parameter keys."""
 import numpy as np
 import pytest
 
-from crankmodal.dynamics import contact
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.laws import LAWS
-from crankmodal.dynamics.stage import short_contact_warning
+from crankmodal.dynamics.laws import contact
+from crankmodal.dynamics.laws.objects import LAWS
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.scene.stage import short_contact_warning
 
 R, C = 0.02, 1e-4  # journal radius, radial clearance, m
 #: the scene's law parameters (build.contact_arguments passes every law all of them)

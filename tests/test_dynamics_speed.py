@@ -1,4 +1,4 @@
-"""The compiled right-hand side (crankmodal.dynamics.compiled) against the Python path.
+"""The compiled right-hand side (crankmodal.dynamics.kernel.compiled) against the Python path.
 
 Oracle: the generic Python evaluation of the same system (``Multibody(compiled=False)``), state
 by state for every normal and friction law and for round, worn and lubricated (short film)
@@ -11,12 +11,14 @@ path."""
 import numpy as np
 import pytest
 
-from crankmodal.dynamics import Cylinder, contact, crank_train, laws
-from crankmodal.dynamics.analysis import simulate
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import AUX_NAMES, Multibody
+from crankmodal.dynamics import Cylinder, crank_train
+from crankmodal.dynamics.laws import contact
+from crankmodal.dynamics.laws import objects as laws
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import AUX_NAMES, Multibody
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
+from crankmodal.dynamics.run.simulate import simulate
 
 PARAMS = {"stiffness": 2e10, "exponent": 1.4, "damping": 800.0, "penetration": 5e-5,
           "restitution": 0.7, "radial_clearance": 1e-4}
@@ -240,7 +242,7 @@ def test_what_has_no_compiled_form_stays_on_the_python_path():
 def _synthetic_flexible(name, k, frames, rng, mass=1.5, j0=4e-3, tilt=0):
     """A FlexibleBody with random but admissible invariants (no FE): G symmetric positive
     definite, S antisymmetric, interface maps random; ``tilt`` stiffness-free coordinates."""
-    from crankmodal.dynamics.flexible import FlexibleBody
+    from crankmodal.dynamics.flexible.body import FlexibleBody
 
     X = rng.normal(size=(k, k)) * 0.1
     G = np.eye(k) * 0.8 + X @ X.T * 0.1
@@ -338,7 +340,8 @@ def test_attached_inertias_compiled_equal_the_python_path_state_by_state():
 
 
 def test_the_kernel_integrates_every_power_the_system_names():
-    from crankmodal.dynamics import compiled, system
+    from crankmodal.dynamics.kernel import compiled
+    from crankmodal.dynamics.model import system
 
     assert compiled.N_AUX == system.N_AUX == len(system.AUX_NAMES)
 

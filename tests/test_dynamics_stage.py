@@ -59,7 +59,7 @@ def test_kelvin_voigt_without_a_stiffness_is_refused_naming_the_key():
                                          r"contact.law = 'kelvin_voigt'.* N/m at 10 kN$") as exc:
         check(_scene(data))
     # the advice's value: the Hertz tangent 1.5 K^(2/3) F^(1/3) (closed form d(K d^1.5)/dd)
-    from crankmodal.dynamics.contact import cylinder_stiffness
+    from crankmodal.dynamics.laws.contact import cylinder_stiffness
 
     kh = cylinder_stiffness(0.02, 0.0201, 2.1e11, 0.3, 2.1e11, 0.3)
     delta = (1e4 / kh) ** (2.0 / 3.0)
@@ -117,7 +117,7 @@ def test_machine_defaults_build_the_seed_loom_four_bar(tmp_path):
 
 
 def test_film_model_is_a_scene_key_that_reaches_the_joint(tmp_path):
-    from crankmodal.dynamics.build import build_mechanism
+    from crankmodal.dynamics.scene.build import build_mechanism
 
     data = {"dynamics": {"machine": "loom_four_bar", "end_time": 0.02, "run_ideal": False}}
     scene = scene_from_dict(data, overrides=["dynamics.clearances.0.film_model=finite"])
@@ -194,8 +194,8 @@ def test_a_run_of_exactly_ramp_plus_two_revolutions_keeps_the_start_up_out_of_th
     # and, at equality (reached exactly for these output grids), opened at the ramp's end: at 0
     # for ramp 0, the start transient inside the peaks. By definition (README: spectrum_start
     # defaults to the ramp plus one revolution) it opens at ramp + T and holds one revolution.
-    from crankmodal.dynamics.analysis import output_times
-    from crankmodal.dynamics.stats import results_window
+    from crankmodal.dynamics.results.stats import results_window
+    from crankmodal.dynamics.run.simulate import output_times
 
     rev = rpm / 60.0
     t = output_times(ramp + 2.0 / rev, 1.0 / (360.0 * rev))

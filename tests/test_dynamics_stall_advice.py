@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from test_dynamics_stepbound import _pendulum
 
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.joints import Revolute
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.joints import Revolute
+from crankmodal.dynamics.model.system import Multibody
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 from crankmodal.errors import NumericalError
 
 

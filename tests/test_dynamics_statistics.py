@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from crankmodal.dynamics import Cylinder, SolverSettings, crank_train, simulate
-from crankmodal.dynamics.stats import (
+from crankmodal.dynamics.results.stats import (
     block_of,
     impact_velocity_statistics,
     per_revolution_peaks,
@@ -305,7 +305,7 @@ def test_headline_takes_the_ensemble_spread_only_where_trajectories_disagree_bey
     # means 10 / 20 / 30 with standard errors 1 each disagree (std 10 > 1): 20 ± 10, spread;
     # means 10.0 / 10.1 / 9.9 with standard errors 1 agree (std 0.1 < 1): the revolutions pool,
     # 10 ± 1/sqrt(3), standard error; one trajectory: its own mean and standard error.
-    from crankmodal.dynamics.ensemble import headline_value
+    from crankmodal.dynamics.run.ensemble import headline_value
 
     h = headline_value([10.0, 20.0, 30.0], [1.0, 1.0, 1.0])
     assert h["value"] == pytest.approx(20.0) and h["uncertainty"] == pytest.approx(10.0)

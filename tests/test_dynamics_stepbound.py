@@ -7,12 +7,12 @@ its period: halving every frequency halves the evaluations."""
 import numpy as np
 import pytest
 
-from crankmodal.dynamics.bodies import Ground
-from crankmodal.dynamics.flexible import FlexibleBody
-from crankmodal.dynamics.joints import Revolute
-from crankmodal.dynamics.simulate import SolverSettings, integrate
-from crankmodal.dynamics.stepbound import step_bound
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.flexible.body import FlexibleBody
+from crankmodal.dynamics.flexible.stepbound import step_bound
+from crankmodal.dynamics.model.bodies import Ground
+from crankmodal.dynamics.model.joints import Revolute
+from crankmodal.dynamics.model.system import Multibody
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 
 
 def _pendulum(scale):

@@ -14,11 +14,11 @@ import pytest
 from conftest import SCENES
 
 from crankmodal import cli, progress
-from crankmodal.dynamics import timescales
-from crankmodal.dynamics.bodies import Ground, RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.simulate import SolverSettings, _stiffness_advice, integrate
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.model.bodies import Ground, RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import Multibody
+from crankmodal.dynamics.run import timescales
+from crankmodal.dynamics.run.integrate import SolverSettings, _stiffness_advice, integrate
 
 
 def _run(*argv):
@@ -100,8 +100,8 @@ def test_advice_never_names_the_method_in_use(method):
 def test_over_budget_advice_names_the_damping_when_it_limits_the_step():
     # a kelvin-voigt dashpot of 1e6 N s/m on 2 kg: m/c = 2e-6 s against T/pi = 2.8e-4 s
     sysm, _ = _journal(2.0, params={"stiffness": 1e8, "damping": 1e6})
-    from crankmodal.dynamics.laws import KelvinVoigt
-    from crankmodal.dynamics.timescales import TimeScale
+    from crankmodal.dynamics.laws.objects import KelvinVoigt
+    from crankmodal.dynamics.run.timescales import TimeScale
     ts = TimeScale("c", 2.0, 100.0, 1e8, 2 * np.pi * np.sqrt(2e-8), 1e6, 2e-6,
                    KelvinVoigt(1e8, 1e6))
     s = SolverSettings(method="RK45", max_rhs_evals=200, time_scales=(ts,))

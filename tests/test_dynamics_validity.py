@@ -16,12 +16,12 @@ import re
 import numpy as np
 import pytest
 
-from crankmodal.dynamics.flexstage import dynamic_stress
-from crankmodal.dynamics.validity import (
+from crankmodal.dynamics.results.validity import (
     DEFLECTION_FRACTION,
     elastic_deflection,
     flexible_validity,
 )
+from crankmodal.dynamics.scene.flexstage import dynamic_stress
 
 L, H, T = 0.075, 0.016, 0.008
 E, NU, RHO = 2.1e11, 0.3, 7850.0
@@ -33,7 +33,7 @@ G = E / (2 * (1 + NU))
 
 @pytest.fixture(scope="module")
 def coupler():
-    from crankmodal.dynamics.flexbuild import link_body, reduced_bar
+    from crankmodal.dynamics.flexible.build import link_body, reduced_bar
 
     spec = {"bar": [H, T], "material": "steel", "mesh_size": 0.004, "element_order": 2,
             "fixed_interface_modes": 12, "n_modes": None, "cutoff_hz": None,
@@ -165,7 +165,7 @@ def test_an_api_run_is_checked_the_same_way(coupler):
     as flexible_validity's."""
     from types import SimpleNamespace
 
-    from crankmodal.dynamics.validity import check_flexible_bodies
+    from crankmodal.dynamics.results.validity import check_flexible_bodies
     from crankmodal.errors import ModelWarning
 
     modal, q = _static_state(coupler, 3e6)

@@ -4,9 +4,9 @@ Python path (ClearanceJoint) and in the compiled kernel (Multibody.gap, penetrat
 import numpy as np
 import pytest
 
-from crankmodal.dynamics.bodies import RigidBody
-from crankmodal.dynamics.clearance import ClearanceJoint
-from crankmodal.dynamics.system import Multibody
+from crankmodal.dynamics.model.bodies import RigidBody
+from crankmodal.dynamics.model.clearance import ClearanceJoint
+from crankmodal.dynamics.model.system import Multibody
 
 R_J = 0.024                       # m, journal radius D/2
 D_MIN, D_MAX = 1.0e-4, 3.0e-4     # m, seed 003's diametral clearances Delta_min, Delta_max

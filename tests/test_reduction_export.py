@@ -289,9 +289,9 @@ def test_a_spinning_bar_moves_alike_in_exudyn_and_in_crankmodals_dynamics(reduce
     exu = pytest.importorskip("exudyn")
     import exudyn.itemInterface as eii
 
-    from crankmodal.dynamics.flexible import load_flexible_body
-    from crankmodal.dynamics.simulate import SolverSettings, integrate
-    from crankmodal.dynamics.system import Multibody
+    from crankmodal.dynamics.flexible.body import load_flexible_body
+    from crankmodal.dynamics.model.system import Multibody
+    from crankmodal.dynamics.run.integrate import SolverSettings, integrate
 
     _, _, body, _ = reduced
     flex = load_flexible_body(save_flexbody(tmp_path / "bar.npz", body), "bar",

@@ -146,7 +146,7 @@ def test_a_nested_block_with_its_own_figures_becomes_a_subsection(tmp_path):
 def test_last_revolutions_selects_by_crank_angle_turned_in_either_sense():
     from types import SimpleNamespace
 
-    from crankmodal.dynamics.plots import last_revolutions
+    from crankmodal.dynamics.results.plots import last_revolutions
 
     a = np.linspace(0.0, 5 * 2 * np.pi, 501)  # five turns
     for sign in (1.0, -1.0):
@@ -170,7 +170,7 @@ def _orbit_hist():
 def test_orbit_draws_the_last_revolutions_coloured_by_time_and_the_circle_bold():
     from matplotlib.figure import Figure
 
-    from crankmodal.dynamics.plots import draw_orbit, last_revolutions
+    from crankmodal.dynamics.results.plots import draw_orbit, last_revolutions
 
     hist, last = _orbit_hist()
     ax = Figure().subplots()
@@ -189,7 +189,7 @@ def test_orbit_draws_the_last_revolutions_coloured_by_time_and_the_circle_bold()
 def test_orbit_png_is_written_in_colour(tmp_path):
     from PIL import Image
 
-    from crankmodal.dynamics.plots import plot_orbit
+    from crankmodal.dynamics.results.plots import plot_orbit
 
     hist, _ = _orbit_hist()
     img = np.asarray(Image.open(plot_orbit(hist, {"j": 1e-4}, tmp_path / "o.png")).convert("RGB"))
@@ -204,7 +204,7 @@ def test_piston_plot_draws_the_ideal_run_dashed_on_top_and_the_last_revolutions(
     dashed, above it in every panel; the middle and right panels hold the last 2 revolutions."""
     from types import SimpleNamespace
 
-    from crankmodal.dynamics import plots
+    from crankmodal.dynamics.results import plots
 
     t = np.linspace(0.0, 0.25, 2501)
     ang = -2 * np.pi * 20.0 * t  # five revolutions, turning in the negative sense

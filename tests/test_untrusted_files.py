@@ -48,7 +48,7 @@ def good(tmp_path_factory):
     folder = tmp_path_factory.mktemp("good")
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("CRANKMODAL_CACHE", str(folder / "cache"))
-        from crankmodal.dynamics.flexbuild import reduced_bar
+        from crankmodal.dynamics.flexible.build import reduced_bar
 
         path = reduced_bar(*COUPLER, SPEC, "dynamics.flexible.coupler")
     return shutil.copy(path, folder / "good.npz")
@@ -250,7 +250,7 @@ def test_damaged_flexbody_in_a_scene_exits_2_naming_file_and_member(good, kind, 
 
 
 def test_damaged_cached_flexbody_is_rebuilt_with_a_warning(tmp_path, monkeypatch):
-    from crankmodal.dynamics.flexbuild import reduced_bar
+    from crankmodal.dynamics.flexible.build import reduced_bar
     from crankmodal.reduction.io import load_flexbody
 
     monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path / "cache"))
@@ -400,7 +400,7 @@ def test_bar_count_is_six_tetrahedra_per_grid_cell_and_refused_over_the_limit():
 
 @pytest.mark.parametrize("size", [1e-6, 1e-300, 5e-324])
 def test_reduced_bar_refuses_a_tiny_mesh_size_before_taking_memory(size, tmp_path, monkeypatch):
-    from crankmodal.dynamics.flexbuild import reduced_bar
+    from crankmodal.dynamics.flexible.build import reduced_bar
 
     monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path))
     with pytest.raises(ResourceError, match=r"dynamics.flexible.coupler.mesh_size = .* tetrahedra"):

@@ -38,7 +38,7 @@ STAGES: dict[str, str] = {
     "reduction": "crankmodal.reduction.stage",
     "torsion": "crankmodal.torsion.stage",
     "mechanism": "crankmodal.mechanism.stage",
-    "dynamics": "crankmodal.dynamics.stage",
+    "dynamics": "crankmodal.dynamics.scene.stage",
     "report": "crankmodal.report.stage",
 }
 

@@ -1,23 +1,36 @@
 """Planar crank-linkage dynamics with ideal and clearance joints.
 
 Bodies expose interface frames; joints (ideal pins, sliders, the crank drive) and clearance
-joints see only those frames, so a flexible body can later replace a rigid one. Modules:
-``contact`` (force and friction laws), ``lubrication`` (short-bearing film force), ``bodies``,
-``joints``, ``clearance``, ``loads``, ``system`` (the DAE), ``fastpath`` (vectorised rigid
-constraints), ``simulate`` (integration with contact events), ``history`` (sampled outputs and
-energy balance), ``signals`` (spectra, impacts, contact loss), ``mechanisms`` (slider-crank
-trains, four-star, four-bar), ``analysis`` (checked runs, tolerance study), ``scene_keys``,
-``build``, ``bridge`` (machines of :mod:`crankmodal.mechanism`), ``plots``, ``stage``,
-``flexible`` (planar floating-frame body from a reduced ``.npz``), ``flexbuild`` (crank, rod and
-four-bar link bodies from reduced files), ``initial`` (the quasi-static start of flexible bodies).
+joints see only those frames, so a flexible body can replace a rigid one. Subpackages, in the
+order data flows:
+
+``model``
+    bodies, ideal joints, clearance joints, loads, the assembled DAE (``system``), the builders
+    of crank trains and four-bars (``mechanisms``) and of machines of :mod:`crankmodal.mechanism`
+    (``bridge``).
+``laws``
+    contact and friction laws (``contact`` functions, ``objects`` classes), the short-bearing
+    (``lubrication``) and finite-length (``reynolds``) oil films.
+``flexible``
+    planar floating-frame bodies from reduced files (``body``), crank, rod and link bodies
+    (``build``), the quasi-static start (``initial``), modal damping and step bounds.
+``kernel``
+    the compiled (Numba) evaluator of a built system.
+``run``
+    the integrator driver (``integrate``), checked runs (``simulate``), run budgets, contact
+    time scales and ensembles.
+``results``
+    sampled histories and energy balance, signals, per-revolution statistics, validity, figures.
+``scene``
+    the ``[dynamics]`` scene stage: keys, validation, building from a scene.
 """
 
-from .analysis import simulate, tolerance_study
-from .flexbuild import crank_body, link_body, rod_body
-from .flexible import FlexibleBody, load_flexible_body
-from .initial import quasi_static_start
-from .mechanisms import Cylinder, Mechanism, crank_train, four_bar
-from .simulate import SolverSettings, auto_method
+from .flexible.body import FlexibleBody, load_flexible_body
+from .flexible.build import crank_body, link_body, rod_body
+from .flexible.initial import quasi_static_start
+from .model.mechanisms import Cylinder, Mechanism, crank_train, four_bar
+from .run.integrate import SolverSettings, auto_method
+from .run.simulate import simulate, tolerance_study
 
 __all__ = ["Cylinder", "FlexibleBody", "Mechanism", "SolverSettings", "auto_method",
            "crank_body", "crank_train", "four_bar", "link_body", "load_flexible_body",

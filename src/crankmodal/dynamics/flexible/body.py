@@ -57,7 +57,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError
+from ...errors import SceneError
 
 DEFAULT_DAMPING = 0.02
 """Modal damping ratio of every kept mode when none is given (2 %, a common value for steel
@@ -347,7 +347,7 @@ def load_flexible_body(path, name: str, **kwargs) -> FlexibleBody:
     SceneError
         As :func:`planar_body`.
     """
-    from ..reduction.io import load_flexbody
+    from ...reduction.io import load_flexbody
 
     return planar_body(load_flexbody(path), name, path=path, **kwargs)
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ParameterError, SceneError, scene_keys
+from ...errors import ParameterError, SceneError, scene_keys
 
 #: relative tolerance on the crank radius and rod length a reduced body must match
 GEOMETRY_TOLERANCE = 0.01
@@ -33,7 +33,7 @@ GEOMETRY_TOLERANCE = 0.01
 
 def flexbody_cache_dir() -> Path:
     """``$CRANKMODAL_CACHE/flexbodies`` (default ``~/.cache/crankmodal/flexbodies``)."""
-    from ..caches import cache_folder
+    from ...caches import cache_folder
 
     return cache_folder("flexbodies")
 
@@ -43,9 +43,9 @@ def cached_flexbody(path: Path, where: str) -> bool:
     emptied: :func:`~crankmodal.reduction.io.load_flexbody` refuses it) is removed with a
     one-line warning naming it and what is wrong, so that the caller rebuilds it, as
     :mod:`crankmodal.geometry.cache` does for parts."""
-    from ..caches import discard_damaged
-    from ..errors import InputFileError
-    from ..reduction.io import load_flexbody
+    from ...caches import discard_damaged
+    from ...errors import InputFileError
+    from ...reduction.io import load_flexbody
 
     if not path.is_file():
         return False
@@ -62,7 +62,7 @@ def cached_flexbody(path: Path, where: str) -> bool:
 def _reduction_source_digest() -> str:
     h = hashlib.sha256()
     for folder in ("reduction", "fem"):
-        for path in sorted((Path(__file__).parent.parent / folder).glob("*.py")):
+        for path in sorted((Path(__file__).parents[2] / folder).glob("*.py")):
             h.update(path.read_bytes())
     return h.hexdigest()
 
@@ -95,8 +95,8 @@ def check_part(machine: str, part: str, spec: dict) -> tuple[dict, dict]:
     """
     from types import SimpleNamespace
 
-    from ..fem.material_stage import validate as validate_material
-    from ..geometry.stage import validate as validate_geometry
+    from ...fem.material_stage import validate as validate_material
+    from ...geometry.stage import validate as validate_geometry
 
     where = f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
     raw = {"machine": machine, "part": part, "fidelity": spec["fidelity"],
@@ -127,14 +127,14 @@ def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
         Rods on the crank (crankshaft only): each crankpin region is cut into
         ``ceil(n_rods / crankpin regions)`` bands, one interface each.
     """
-    from ..fem.assembly import assemble
-    from ..fem.material_stage import make_material
-    from ..geometry.cache import part_key
-    from ..geometry.stage import make_part
-    from ..reduction.interfaces import make_interfaces
-    from ..reduction.io import save_flexbody
-    from ..reduction.reduce import reduce_body
-    from ..reduction.stage import interface_specs
+    from ...fem.assembly import assemble
+    from ...fem.material_stage import make_material
+    from ...geometry.cache import part_key
+    from ...geometry.stage import make_part
+    from ...reduction.interfaces import make_interfaces
+    from ...reduction.io import save_flexbody
+    from ...reduction.reduce import reduce_body
+    from ...reduction.stage import interface_specs
 
     where = f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
     gp, mp = check_part(machine, part, spec)
@@ -149,7 +149,7 @@ def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
         return path
     import time
 
-    from ..progress import PhaseTimings
+    from ...progress import PhaseTimings
 
     steps = PhaseTimings(f"{where}: reducing the {part}", 4)
     t0 = time.perf_counter()
@@ -187,7 +187,7 @@ def _in_plane_angle(v) -> float:
 def read(source):
     """``(reduced body, path)`` of a flexbody file path, or of a body read already (so that
     several planar bodies are made from one reading)."""
-    from ..reduction.io import load_flexbody
+    from ...reduction.io import load_flexbody
 
     if isinstance(source, (str, Path)):
         return load_flexbody(source), Path(source)
@@ -214,8 +214,8 @@ def body_spec(spec, link: bool = False) -> dict:
         Naming ``spec.<key>``: an unknown key, a value out of its range, or both ``n_modes`` and
         ``cutoff_hz``.
     """
-    from .. import arguments as arg
-    from .scene_keys import FLEX_BODY, LINK_BODY
+    from ... import arguments as arg
+    from ..scene.keys import FLEX_BODY, LINK_BODY
 
     schema = LINK_BODY if link else FLEX_BODY
     out = arg.table("spec", spec, schema)
@@ -239,7 +239,7 @@ def _source(source):
 
 
 def _rows(row_z) -> list[float]:
-    from .. import arguments as arg
+    from ... import arguments as arg
 
     return arg.numbers("row_z", [0.0] if row_z is None else row_z)
 
@@ -276,8 +276,8 @@ def crank_body(source, spec: dict | None = None, row_z=None, crank_radius: float
         Naming ``spec.<key>``, ``row_z``, ``crank_radius`` or ``source`` (interfaces missing,
         or the crank radius off).
     """
-    from .. import arguments as arg
-    from .flexible import planar_body
+    from ... import arguments as arg
+    from .body import planar_body
 
     spec = body_spec(spec)
     row_z = _rows(row_z)
@@ -344,8 +344,8 @@ def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
     -------
     FlexibleBody
     """
-    from .. import arguments as arg
-    from .flexible import planar_body
+    from ... import arguments as arg
+    from .body import planar_body
 
     spec = body_spec(spec)
     rod_length = arg.number("rod_length", rod_length, gt=0.0, optional=True)
@@ -373,7 +373,7 @@ def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
 def _bar_arguments(length, section, spec) -> None:
     """The Python API's arguments of :func:`reduced_bar` (a scene's are validated already):
     a ParameterError naming ``length``, ``section`` or ``spec.<key>``."""
-    from ..geometry.mesh import is_length
+    from ...geometry.mesh import is_length
 
     if not is_length(length):
         raise ParameterError("length", f"must be a number > 0 m, got {length!r}")
@@ -409,11 +409,11 @@ def check_bar(length: float, section, spec: dict, key: str) -> tuple:
     ResourceError
         Too many tetrahedra, naming ``<key>.mesh_size`` and the smallest size allowed.
     """
-    from ..errors import ResourceError
-    from ..fem.memory import available_bytes
-    from ..fem.testparts import check_bar_size
-    from ..geometry.checks import MAX_LENGTH, MIN_LENGTH
-    from ..geometry.mesh import MAX_ELEMENTS, MeshSizeError, fe_element_limit
+    from ...errors import ResourceError
+    from ...fem.memory import available_bytes
+    from ...fem.testparts import check_bar_size
+    from ...geometry.checks import MAX_LENGTH, MIN_LENGTH
+    from ...geometry.mesh import MAX_ELEMENTS, MeshSizeError, fe_element_limit
 
     _bar_arguments(length, section, spec)
     sizes = f"the sizes crankmodal builds, [{MIN_LENGTH:g}, {MAX_LENGTH:g}] m"
@@ -448,13 +448,13 @@ def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
     ``end_x1`` with distributing (RBE3) couplings: each joint is the mean motion of an end face,
     at the face centre. ``key`` names the scene table in messages.
     """
-    from ..fem.assembly import assemble
-    from ..fem.material_stage import make_material
-    from ..fem.material_stage import validate as validate_material
-    from ..fem.testparts import bar
-    from ..reduction.interfaces import make_interfaces
-    from ..reduction.io import save_flexbody
-    from ..reduction.reduce import reduce_body
+    from ...fem.assembly import assemble
+    from ...fem.material_stage import make_material
+    from ...fem.material_stage import validate as validate_material
+    from ...fem.testparts import bar
+    from ...reduction.interfaces import make_interfaces
+    from ...reduction.io import save_flexbody
+    from ...reduction.reduce import reduce_body
 
     div = check_bar(length, section, spec, key)
     width, thickness = (float(v) for v in section)
@@ -510,9 +510,9 @@ def link_body(source, spec: dict | None = None, length: float | None = None,
         Frames named for its joints (aliases of the interfaces), body x axis from the first
         joint to the second; ``info["roles"]`` maps joint to interface.
     """
-    from .. import arguments as arg
-    from .flexible import planar_body
-    from .mechanisms import FOUR_BAR_JOINTS
+    from ... import arguments as arg
+    from ..model.mechanisms import FOUR_BAR_JOINTS
+    from .body import planar_body
 
     spec = body_spec(spec, link=True)
     length = arg.number("length", length, gt=0.0, optional=True)
@@ -564,7 +564,7 @@ def rigid_twin(body):
     RigidBody or FlexibleBody
         The twin, with the same name, mass (kg), polar inertia (kg m²) and frames.
     """
-    from .bodies import RigidBody
+    from ..model.bodies import RigidBody
 
     if body.n_tilt:
         return body.frozen()

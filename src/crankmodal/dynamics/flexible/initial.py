@@ -59,7 +59,7 @@ def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
     ParameterError
         Naming ``q``, ``qd`` (not ``sysm.n`` finite numbers), ``t``, ``tol`` or ``max_iter``.
     """
-    from .. import arguments as arg
+    from ... import arguments as arg
 
     q = np.asarray(arg.numbers("q", np.asarray(q, float).ravel(), length=sysm.n), float)
     qd = np.asarray(arg.numbers("qd", np.asarray(qd, float).ravel(), length=sysm.n), float)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .timescales import EVALS_PER_STEP  # evaluations per accepted step (FSAL counted once)
+from ..run.timescales import EVALS_PER_STEP  # evaluations per accepted step (FSAL counted once)
 
 #: ``ω h`` above which the step counts as bound by the mode (the stability limit of RK45 is
 #: about 3.3 on the imaginary axis; its controller keeps the mean step near half of it: 1.5 on

@@ -33,14 +33,14 @@ import numpy as np
 from numba import njit
 from scipy.linalg.lapack import dgesv as _gesv
 
-from .bodies import Ground, RigidBody
-from .clearance import ClearanceJoint, worn_bore_clearance
-from .fastpath import frames_of
-from .flexible import FlexibleBody
-from .joints import AngleDrive, Prismatic, Revolute
-from .loads import CrankTorque, PistonLoads
-from .lubrication import film_arguments, short_film
-from .reynolds import film_spline, finite_film
+from ..flexible.body import FlexibleBody
+from ..laws.lubrication import film_arguments, short_film
+from ..laws.reynolds import film_spline, finite_film
+from ..model.bodies import Ground, RigidBody
+from ..model.clearance import ClearanceJoint, worn_bore_clearance
+from ..model.fastpath import frames_of
+from ..model.joints import AngleDrive, Prismatic, Revolute
+from ..model.loads import CrankTorque, PistonLoads
 
 #: per clearance joint diagnostics written by the kernel (columns of ``diag``)
 DIAG = ("ex", "ey", "nx", "ny", "d", "delta", "delta_dot", "v_slip", "fn", "ft", "fx", "fy",
@@ -897,7 +897,8 @@ def _flush_if_dependencies_changed() -> bool:
     import hashlib
     from pathlib import Path
 
-    from . import clearance, lubrication, reynolds
+    from ..laws import lubrication, reynolds
+    from ..model import clearance
 
     digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes()
                                      for m in (clearance, lubrication, reynolds))).hexdigest()

@@ -41,7 +41,7 @@ from . import contact
 
 
 def _number(name: str, value) -> float:
-    from ..errors import ParameterError
+    from ...errors import ParameterError
 
     try:
         return float(value)
@@ -50,7 +50,7 @@ def _number(name: str, value) -> float:
 
 
 def _positive(name: str, value) -> float:
-    from ..errors import ParameterError
+    from ...errors import ParameterError
 
     v = _number(name, value)
     if not (math.isfinite(v) and v > 0.0):
@@ -59,7 +59,7 @@ def _positive(name: str, value) -> float:
 
 
 def _non_negative(name: str, value) -> float:
-    from ..errors import ParameterError
+    from ...errors import ParameterError
 
     v = _number(name, value)
     if not (math.isfinite(v) and v >= 0.0):
@@ -68,7 +68,7 @@ def _non_negative(name: str, value) -> float:
 
 
 def _restitution(value) -> float:
-    from ..errors import ParameterError
+    from ...errors import ParameterError
 
     v = _number("restitution", value)
     if not (0.0 < v <= 1.0):
@@ -413,7 +413,7 @@ LAWS: dict[str, type[NormalLaw]] = {c.name: c for c in (
 
 
 def _build(registry, kind, name, params):
-    from ..errors import ParameterError
+    from ...errors import ParameterError
 
     try:
         cls = registry[name]

@@ -37,7 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from ..errors import NumericalError
+from ...errors import NumericalError
 
 CAVITATION = ("reynolds", "half_sommerfeld")
 INLETS = ("max_film", "free")
@@ -260,7 +260,7 @@ def _table_values(l_over_d: float, n_theta: int, n_zeta: int) -> np.ndarray:
     import json
     from pathlib import Path
 
-    from ..caches import cache_folder, discard_damaged, write_npz_atomically
+    from ...caches import cache_folder, discard_damaged, write_npz_atomically
 
     shape = (EPS_TABLE.size, ALPHA_TABLE.size, 2)
     key = hashlib.sha256(json.dumps({

@@ -82,7 +82,7 @@ class RigidBody:
     ndof = 3
 
     def __post_init__(self):
-        from .. import arguments as arg
+        from ... import arguments as arg
 
         self.mass = arg.number("mass", self.mass, ge=0.0)
         self.inertia = arg.number("inertia", self.inertia, ge=0.0)
@@ -91,7 +91,7 @@ class RigidBody:
         for key, value in frames.items():
             value = arg.numbers(f"frames.{key}", value)
             if len(value) not in (2, 3):
-                from ..errors import ParameterError
+                from ...errors import ParameterError
 
                 raise ParameterError(f"frames.{key}", f"must be (x, y) or (x, y, phi), got "
                                      f"{len(value)} numbers")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SceneError
+from ...errors import SceneError
 from .loads import tabulated_gas_force
 from .mechanisms import Cylinder
 
@@ -24,8 +24,8 @@ def cylinders_from_mechanism(mech_params: dict, ring_friction: float = 0.0):
         ``crank_radius`` (m), ``cylinders`` (list of :class:`Cylinder`), ``direction`` (-1),
         ``speed_rpm``, ``crank_unbalance`` (kg m).
     """
-    from ..mechanism.analysis import analyse
-    from ..mechanism.machine import machine_from_params
+    from ...mechanism.analysis import analyse
+    from ...mechanism.machine import machine_from_params
 
     m = machine_from_params(mech_params)
     # checked here, before the analysis, and under the scene's name (Cylinder.from_machine

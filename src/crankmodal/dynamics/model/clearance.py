@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from . import laws
-from .lubrication import film_arguments, short_film
+from ..laws import objects as laws
+from ..laws.lubrication import film_arguments, short_film
 
 FILM_MODELS = ("short", "finite")
 
@@ -152,7 +152,7 @@ class ClearanceJoint:
         eps, wedge, eps_dot = film_arguments(k["d"], float(n @ k["vrel"]), float(t @ k["vrel"]),
                                              k["omega_sum"], c, self.eps_max)
         if self.film_model == "finite":
-            from .reynolds import finite_bearing_film as law
+            from ..laws.reynolds import finite_bearing_film as law
         else:
             law = short_film
         fr, ftan = law(eps, wedge, eps_dot, self.viscosity, self.journal_radius,

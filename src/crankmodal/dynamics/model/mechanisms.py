@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ParameterError
+from ...errors import ParameterError
 from .bodies import Ground, RigidBody
 from .clearance import ClearanceJoint
 from .joints import AngleDrive, Prismatic, Revolute, SpeedProfile
@@ -73,8 +73,8 @@ class Cylinder:
         naming the field): lengths and masses > 0, ``rod_com >= 0``; ``rod_inertia >= 0``
         (0 only with a rod body given to :func:`crank_train`, which brings its own inertia);
         angles and offsets finite; ``gas_force`` None or callable; ``ring_friction >= 0``."""
-        from .. import arguments as arg
-        from .scene_keys import CRANK_TRAIN, SCHEMA
+        from ... import arguments as arg
+        from ..scene.keys import CRANK_TRAIN, SCHEMA
 
         self.axis_angle = arg.number("axis_angle", self.axis_angle)
         for name in ("rod_length", "rod_mass", "rod_com", "piston_mass", "offset"):
@@ -104,7 +104,7 @@ class Cylinder:
         cylinder : crankmodal.mechanism.machine.Cylinder
             One of ``machine.cylinders``; its crankpin must be the shared one (throw angle 0).
         gas_force : callable, optional
-            Gas force on the piston against crank angle (see :mod:`crankmodal.dynamics.loads`).
+            Gas force on the piston against crank angle (see :mod:`crankmodal.dynamics.model.loads`).
         ring_friction : float
             Coulomb ring friction force, N.
 
@@ -194,7 +194,7 @@ class Mechanism:
         clearance) and keeps its ``{"iterations", "residual"}`` in ``start_info``. :func:`~.analysis.simulate` calls it before the first
         run unless told ``start="undeformed"``. Without elastic modes nothing changes.
         """
-        from .initial import quasi_static_start
+        from ..flexible.initial import quasi_static_start
 
         self.q0, self.qd0, self.start_info = quasi_static_start(self.ideal, self.q0, self.qd0)
         return self.start_info
@@ -223,7 +223,7 @@ def _unit(angle):
 
 def _split(pins, clearance_specs, contact_kw):
     """Ideal pins and clearance joints from the pin list and {name: spec}."""
-    from .. import arguments as arg
+    from ... import arguments as arg
 
     clearance_specs = arg.table("clearances", clearance_specs, {p.name for p in pins})
     contact_kw = arg.table("contact_kw", contact_kw, CONTACT_KW)
@@ -257,8 +257,8 @@ CONTACT_KW = ("law", "law_params", "friction", "friction_params", "v_impact_min"
 
 def _clearance_spec(name: str, spec) -> dict:
     """One ``clearances`` entry checked by the ``[[dynamics.clearances]]`` keys' rules."""
-    from .. import arguments as arg
-    from .scene_keys import CLEARANCE
+    from ... import arguments as arg
+    from ..scene.keys import CLEARANCE
 
     keys = ("clearance", "journal_radius", "clearance_major", "wear_angle", "viscosity",
             "bearing_length", "film_model", "contact")
@@ -288,7 +288,7 @@ def _stiffness_hint(kw: dict, spec: dict) -> str:
     """A start for a missing contact stiffness: the scene's default for steel on steel."""
     if "stiffness" in (kw.get("law_params") or {}) or not isinstance(kw.get("law", "impact"), str):
         return ""
-    from .contact import cylinder_stiffness
+    from ..laws.contact import cylinder_stiffness
 
     rj = spec["journal_radius"]
     K = cylinder_stiffness(rj, rj + spec["clearance"], 2.1e11, 0.3, 2.1e11, 0.3)
@@ -314,8 +314,8 @@ def _finish(kind, bodies, pins, others, loads, clearance_specs, contact_kw, q0, 
 def _check_common(speed_rpm, theta0, ramp_time, drive_torque, gravity, baumgarte,
                   direction) -> dict:
     """The arguments crank trains and the four-bar share, by the ``[dynamics]`` keys' rules."""
-    from .. import arguments as arg
-    from .scene_keys import SCHEMA, SOLVER
+    from ... import arguments as arg
+    from ..scene.keys import SCHEMA, SOLVER
 
     # as dynamics.speed_rpm, but 0 (the crank held by its drive) is a state the API runs
     out = {"speed_rpm": arg.number("speed_rpm", speed_rpm, ge=0.0, le=SCHEMA["speed_rpm"].le),
@@ -356,7 +356,7 @@ def _default_roles(body, n_cylinders: int) -> dict:
 
 def _check_roles(body, roles, n_cylinders: int) -> dict:
     """``crank_roles`` (given, or the default of the body's frames) checked against the body."""
-    from .. import arguments as arg
+    from ... import arguments as arg
 
     if roles is None:
         return _default_roles(body, n_cylinders)
@@ -456,8 +456,8 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         ``clearances.main.clearance``, ``crank_roles``…); the bounds are those of the
         ``[dynamics]`` scene keys.
     """
-    from .. import arguments as arg
-    from .scene_keys import CRANK_TRAIN
+    from ... import arguments as arg
+    from ..scene.keys import CRANK_TRAIN
 
     common = _check_common(speed_rpm, theta0, ramp_time, drive_torque, gravity, baumgarte,
                            direction)
@@ -687,8 +687,8 @@ def four_bar(crank_length, coupler_length, rocker_length, rocker_pivot, masses, 
         given body lacks its joint frames, or they are not its link's length apart; the links
         cannot be assembled at ``theta0`` (naming ``rocker_pivot``).
     """
-    from .. import arguments as arg
-    from .scene_keys import FOUR_BAR
+    from ... import arguments as arg
+    from ..scene.keys import FOUR_BAR
 
     common = _check_common(speed_rpm, theta0, ramp_time, drive_torque, gravity, baumgarte,
                            direction)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NumericalError
+from ...errors import NumericalError
 from . import fastpath
 from .bodies import Ground, RigidBody
 from .joints import AngleDrive
@@ -96,7 +96,7 @@ class Multibody:
         if not self.compiled:
             return None
         if self._kernel is None:
-            from . import compiled
+            from ..kernel import compiled
 
             self._kernel = compiled.CompiledSystem(self) if compiled.applicable(self) else False
         return self._kernel or None

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotting import pyplot as _plt
+from ...plotting import pyplot as _plt
 from .plots import _save, last_revolutions
 
 #: what each joint of the four-bar connects (for the panel titles)

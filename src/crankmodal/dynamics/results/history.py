@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .joints import AngleDrive, Revolute
-from .system import AUX_NAMES, N_AUX
+from ..model.joints import AngleDrive, Revolute
+from ..model.system import AUX_NAMES, N_AUX
 
 
 @dataclass

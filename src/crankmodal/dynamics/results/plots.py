@@ -6,12 +6,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..plotting import pyplot as _plt
+from ...plotting import pyplot as _plt
 
 
 def _save(plt, fig, path: Path) -> Path:
     """Lay out, write (PNG, 110 dpi) and close a figure."""
-    from ..results import savefig_atomic
+    from ...results import savefig_atomic
 
     fig.tight_layout()
     try:

@@ -332,7 +332,7 @@ def headline(stats: dict) -> dict:
 
 def _fmt(value: float, sem: float, unit: str) -> str:
     """``18.3 ± 0.9 kN``: value and standard error with a k prefix above 1e4."""
-    from ..report.quantity import number  # no 6.3e+02 beside 4863 (issue 25 #15)
+    from ...report.quantity import number  # no 6.3e+02 beside 4863 (issue 25 #15)
 
     k = 1e3 if abs(value) >= 1e4 else 1.0
     return f"{number(value / k)} ± {number(sem / k, 2)} {'k' if k > 1 else ''}{unit}"
@@ -353,7 +353,7 @@ def converged_summary(stats: dict, study: dict | None = None, rtol: float | None
         at = hit[0] if hit else -2
 
     def tag(name):
-        from .analysis import convergence_tag
+        from ..run.simulate import convergence_tag
 
         return convergence_tag(conv.get(name), at, study.get("rel_tol", REL_TOL)) if conv else ""
 
@@ -375,7 +375,7 @@ def converged_summary(stats: dict, study: dict | None = None, rtol: float | None
         parts.append(text)
     out = ", ".join(parts) + f" (mean ± standard error over {n} revs)"
     if conv and len(study["rtol"]) >= 2:
-        from .analysis import convergence_line
+        from ..run.simulate import convergence_line
 
         out += "; " + convergence_line(study, at, n_trajectories)
     return out

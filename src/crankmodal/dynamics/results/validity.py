@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import contact
+from ..laws import contact
 
 #: a penetration above this fraction of the radial clearance gives a warning
 CLEARANCE_FRACTION = 0.25
@@ -44,7 +44,7 @@ def penetration_warning(cj, depth: float, force: float, E: float = 2.1e11,
     ratio = depth / approach if approach > 0.0 else 0.0  # no force: the clearance alone
     if of_clearance <= CLEARANCE_FRACTION and ratio <= APPROACH_FACTOR:
         return None
-    from ..report.quantity import number, quantity  # 92.3 µm, not 9.23e-05 m (issue 25 #15)
+    from ...report.quantity import number, quantity  # 92.3 µm, not 9.23e-05 m (issue 25 #15)
 
     K = cj.law_params.get("stiffness", float("nan"))  # echoed as a scene value is typed
     return (f"dynamics: joint {cj.name!r} penetrates {quantity(depth, 'm', 3)}, "
@@ -181,8 +181,8 @@ def yield_strength(body) -> tuple[float | None, str | None]:
     name = None if fb is None else (getattr(fb, "info", None) or {}).get("material")
     if not name:
         return None, None
-    from ..errors import ParameterError
-    from ..fem.materials import material
+    from ...errors import ParameterError
+    from ...fem.materials import material
 
     try:
         return material(str(name)).yield_strength, str(name)
@@ -225,7 +225,7 @@ def flexible_validity(body, deflection: dict | None, stress: dict | None, key: s
              "deflection_time_s": None if deflection is None else deflection["time_s"],
              "max_von_mises_pa": sv, "material": mat, "yield_strength_pa": sy,
              "stress_checked": sv is not None and sy is not None}
-    from ..report.quantity import number, quantity  # engineering prefixes, never e+NN
+    from ...report.quantity import number, quantity  # engineering prefixes, never e+NN
 
     out = []
     name = body.name
@@ -256,7 +256,7 @@ def validity_summary(bodies: dict) -> str:
     the model's validity.
 
     ``bodies``: results ``dynamics.flexible.bodies`` (``validity``, ``effective_damping``)."""
-    from ..report.quantity import number, quantity  # never e+NN in a summary
+    from ...report.quantity import number, quantity  # never e+NN in a summary
 
     parts, bad = [], []
     for name, d in bodies.items():
@@ -295,8 +295,8 @@ def check_flexible_bodies(mech, hist, t_start: float = 0.0, warnings: list | Non
     dict
         Body name -> validity block (:func:`flexible_validity`).
     """
-    from ..errors import warn
-    from .flexstage import dynamic_stress, flexible_bodies_of, flexible_key
+    from ...errors import warn
+    from ..scene.flexstage import dynamic_stress, flexible_bodies_of, flexible_key
 
     sel = np.asarray(hist.t) >= t_start
     t = np.asarray(hist.t)[sel]

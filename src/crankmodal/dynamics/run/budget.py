@@ -123,13 +123,13 @@ def _contact_scales(mech) -> list[Stiff]:
 
 def _mode_scale(mech) -> Stiff | None:
     """The stiffest kept elastic mode of the flexible bodies: step ``2 / omega_max``."""
-    from .stepbound import stiffest_mode
+    from ..flexible.stepbound import stiffest_mode
 
     bodies = [b for b in mech.system.bodies if getattr(b, "n_elastic", 0) > 0]
     top = stiffest_mode(bodies)
     if top is None:
         return None
-    from .flexstage import flexible_key  # rod_2 -> dynamics.flexible.rods
+    from ..scene.flexstage import flexible_key  # rod_2 -> dynamics.flexible.rods
 
     name, hz = top
     return Stiff(flexible_key(name).removeprefix("dynamics."), 2.0 / (2.0 * np.pi * hz),
@@ -199,7 +199,7 @@ def check(mech, t_end: float, settings) -> tuple[RunEstimate, list[str]]:
         :data:`REFUSE_FACTOR` times ``max_rhs_evals``: known from the input alone, before any
         integration, so refused as bad input (a scene relabels it ``dynamics.<key>``).
     """
-    from ..errors import ParameterError
+    from ...errors import ParameterError
 
     memo_key = (t_end, settings.method, settings.max_rhs_evals, settings.max_step)
     memo = getattr(mech.system, "_budget_checked", None)

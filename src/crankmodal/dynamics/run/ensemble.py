@@ -120,7 +120,7 @@ def _label(key: str) -> str:
 def headline_text(block: dict, n_revolutions: int) -> str:
     """The summary line's numbers: each quantity once, ``value ± uncertainty``, marked
     ``(spread)`` where the uncertainty is the trajectory-to-trajectory spread."""
-    from ..report.quantity import number
+    from ...report.quantity import number
 
     parts = []
     n_traj = 1
@@ -168,9 +168,9 @@ def run_ensemble(mech, base_stats: dict, n: int, t_end: float, dt: float, settin
         of :func:`.stats.headline` (the names a tolerance study uses, so that it can state
         convergence across the ensemble too); ``wall_time_s``.
     """
-    from .analysis import simulate
-    from .stats import headline as stats_headline
-    from .stats import statistics
+    from ..results.stats import headline as stats_headline
+    from ..results.stats import statistics
+    from .simulate import simulate
 
     rows, sems = [headline(base_stats)], [headline(base_stats, "sem")]
     heads = [stats_headline(base_stats)]  # the tolerance study's statistics, for its verdict

@@ -16,9 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NumericalError
-from ..progress import bar
-from .system import N_AUX, BudgetExceeded, Multibody, NonFinite
+from ...errors import NumericalError
+from ...progress import bar
+from ..model.system import N_AUX, BudgetExceeded, Multibody, NonFinite
 
 
 @dataclass
@@ -65,8 +65,8 @@ class SolverSettings:
     time_scales: tuple = ()
 
     def __post_init__(self):
-        from .. import arguments as arg
-        from .scene_keys import METHODS, SOLVER
+        from ... import arguments as arg
+        from ..scene.keys import METHODS, SOLVER
 
         arg.one_of("method", self.method, METHODS)
         self.rtol = arg.check("rtol", self.rtol, SOLVER["rtol"])
@@ -136,7 +136,7 @@ def system_method(sysm, omega: float | None = None, qd0=None) -> str:
     (rad/s): its clearance joints and whether a body keeps elastic modes. Without ``omega``:
     the speed of its angle drive, else the fastest body rotation in ``qd0`` (rad/s)."""
     if omega is None:
-        from .joints import AngleDrive
+        from ..model.joints import AngleDrive
 
         drives = [abs(c.profile.omega) for c in sysm.constraints if isinstance(c, AngleDrive)]
         spins = [abs(float(qd0[sysm.slices[id(b)].start + 2])) for b in sysm.bodies] \
@@ -206,7 +206,7 @@ def _stiffness_advice(sysm, settings: SolverSettings | None = None) -> str:
     (Radau, or fewer modes), else the speed and masses."""
     method = settings.method if settings is not None else "RK45"
     if not sysm.clearances:
-        from .stepbound import stiffest_mode
+        from ..flexible.stepbound import stiffest_mode
 
         mode = stiffest_mode([b for b in sysm.bodies if getattr(b, "n_elastic", 0) > 0])
         if mode is None:
@@ -281,7 +281,7 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     """
     from scipy.integrate import solve_ivp
 
-    from .. import arguments as arg
+    from ... import arguments as arg
 
     arg.instance("settings", settings, SolverSettings, "a SolverSettings")
     arg.instance("sysm", sysm, Multibody, "a Multibody (mech.system)")

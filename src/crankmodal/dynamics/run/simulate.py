@@ -7,11 +7,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import NumericalError
-from .history import History, record
-from .signals import order_amplitudes
-from .simulate import SolverSettings, integrate
-from .stats import REL_TOL, headline, statistics
+from ...errors import NumericalError
+from ..results.history import History, record
+from ..results.signals import order_amplitudes
+from ..results.stats import REL_TOL, headline, statistics
+from .integrate import SolverSettings, integrate
 
 
 def output_times(t_end: float, output_step: float) -> np.ndarray:
@@ -42,10 +42,10 @@ def check_output(sysm, t_end: float, output_step: float) -> int:
         Naming ``output_step``, with the samples, the memory estimate and the smallest step
         that fits.
     """
-    from ..errors import ParameterError
-    from ..fem.memory import available_bytes
-    from .scene_keys import MAX_OUTPUT_SAMPLES
-    from .system import N_AUX
+    from ...errors import ParameterError
+    from ...fem.memory import available_bytes
+    from ..model.system import N_AUX
+    from ..scene.keys import MAX_OUTPUT_SAMPLES
 
     samples = t_end / output_step + 1.0
     per_sample = 8.0 * FLOATS_PER_STATE_SAMPLE * (2 * sysm.n + N_AUX)
@@ -64,15 +64,15 @@ def check_output(sysm, t_end: float, output_step: float) -> int:
 
 def _check_run(mech, t_end, output_step, settings, energy_tolerance, start):
     """The arguments of :func:`simulate`, by the ``[dynamics]`` keys' rules."""
-    from .. import arguments as arg
-    from .mechanisms import Mechanism
-    from .scene_keys import FLEXIBLE, SCHEMA
+    from ... import arguments as arg
+    from ..model.mechanisms import Mechanism
+    from ..scene.keys import FLEXIBLE, SCHEMA
 
     arg.instance("mech", mech, Mechanism, "a Mechanism (crank_train, four_bar)")
     t_end = arg.check("t_end", t_end, SCHEMA["end_time"])
     output_step = arg.check("output_step", output_step, SCHEMA["output_step"])
     if output_step > t_end:
-        from ..errors import ParameterError
+        from ...errors import ParameterError
 
         raise ParameterError("output_step", f"must be <= t_end ({t_end:g} s), got "
                              f"{output_step:g}")
@@ -87,7 +87,7 @@ def _check_run(mech, t_end, output_step, settings, energy_tolerance, start):
 def resolved(settings: SolverSettings | None, mech) -> SolverSettings:
     """``settings`` (default :class:`SolverSettings`) with ``method = "auto"`` decided for
     ``mech`` (:func:`~.simulate.auto_method`, as a scene decides it)."""
-    from .simulate import system_method
+    from .integrate import system_method
 
     settings = settings or SolverSettings()
     if settings.method != "auto":
@@ -143,7 +143,7 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
     check_output(sysm, t_end, output_step)
     settings = resolved(settings, mech)
     if not ideal:  # refuse what cannot finish within max_rhs_evals, before it runs (.budget)
-        from ..errors import warn
+        from ...errors import warn
         from .budget import check as check_budget
 
         for text in check_budget(mech, t_end, settings)[1]:
@@ -343,7 +343,7 @@ def convergence_tag(c: dict, at: int, rel_tol: float = REL_TOL) -> str:
 def _pct(x: float) -> str:
     """A relative number in percent: two significant digits, whole percent from 10 %, never
     ``e-05`` (:func:`crankmodal.report.quantity.number`)."""
-    from ..report.quantity import number
+    from ...report.quantity import number
 
     return f"{100 * x:.0f}" if 100 * x >= 10 else number(100 * x, 2)
 

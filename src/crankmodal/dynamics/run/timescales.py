@@ -23,7 +23,7 @@ force on a piston and ``m omega**2 r`` (the effective mass on the crank radius a
 
 What a law contributes (its static penetration, tangent stiffness and dashpot under that load,
 and the stiffness that would give another tangent stiffness) the law object answers
-(:class:`crankmodal.dynamics.laws.NormalLaw`); this module knows no law by name.
+(:class:`crankmodal.dynamics.laws.objects.NormalLaw`); this module knows no law by name.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .laws import NormalLaw
+from ..laws.objects import NormalLaw
 
 #: evaluations of the right-hand side per accepted step of the explicit methods
 EVALS_PER_STEP = {"RK45": 6, "DOP853": 12}
@@ -49,7 +49,7 @@ class TimeScale:
     period: float          # T_K = 2 pi sqrt(m / K_lin), s
     damping: float | None  # dashpot c, N s/m (None: the law has none of its own)
     damping_time: float | None  # m / c, s
-    law: NormalLaw         # the joint's normal law (crankmodal.dynamics.laws)
+    law: NormalLaw         # the joint's normal law (crankmodal.dynamics.laws.objects)
 
     @property
     def stiffness(self) -> float:

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SceneError
-from . import contact
-from .loads import tabulated_gas_force
-from .mechanisms import Cylinder, crank_train, four_bar
-from .scene_keys import cylinder_angles
-from .simulate import SolverSettings, auto_method
+from ...errors import SceneError
+from ..laws import contact
+from ..model.loads import tabulated_gas_force
+from ..model.mechanisms import Cylinder, crank_train, four_bar
+from ..run.integrate import SolverSettings, auto_method
+from .keys import cylinder_angles
 
 
 def contact_arguments(p) -> tuple[dict, dict]:
@@ -52,7 +52,7 @@ MIN_FRICTION_TIME = 1e-7
 
 def check_ring_friction(force: float, cylinders) -> None:
     """Refuse a ring friction that would make each piston a near-rigid damper (SceneError)."""
-    from .loads import PistonLoads
+    from ..model.loads import PistonLoads
 
     if force <= 0.0:
         return
@@ -84,7 +84,7 @@ def build_mechanism(p, mechanism_params=None, bodies=None):
     direction = -1 if p["rotation"] == "cw" else 1
     ct = p["crank_train"]
     if p["from_mechanism"]:
-        from .bridge import cylinders_from_mechanism
+        from ..model.bridge import cylinders_from_mechanism
 
         src = cylinders_from_mechanism(mechanism_params, p["ring_friction_n"])
         check_ring_friction(p["ring_friction_n"], src["cylinders"])

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SceneError, scene_keys
+from ...errors import SceneError, scene_keys
 
 #: output samples processed at once when the stress modes are superposed
 STRESS_CHUNK = 64
@@ -25,12 +25,12 @@ STRESS_CHUNK = 64
 def train_geometry(p, mechanism_params):
     """Crank radius (m), rod lengths (m) and row positions (m) of the crank train."""
     if p["from_mechanism"]:
-        from .bridge import cylinders_from_mechanism
+        from ..model.bridge import cylinders_from_mechanism
 
         src = cylinders_from_mechanism(mechanism_params, p["ring_friction_n"])
         cyl = src["cylinders"]
         return src["crank_radius"], [c.rod_length for c in cyl], [c.z for c in cyl]
-    from .scene_keys import cylinder_angles
+    from .keys import cylinder_angles
 
     ct = p["crank_train"]
     n = len(cylinder_angles(p))
@@ -38,7 +38,7 @@ def train_geometry(p, mechanism_params):
 
 
 def _file(spec, machine, part, n_rods, key):
-    from .flexbuild import reduced_part
+    from ..flexible.build import reduced_part
 
     if spec["file"] is not None:
         return Path(spec["file"])
@@ -56,7 +56,7 @@ def body_keys(key: str):
 
 def link_length(p, role: str) -> float:
     """The four-bar's length of link ``role`` (crank, coupler, rocker), m."""
-    from .scene_keys import FOUR_BAR_LINKS
+    from .keys import FOUR_BAR_LINKS
 
     return float(p["four_bar"]["lengths"][FOUR_BAR_LINKS.index(role)])
 
@@ -64,9 +64,9 @@ def link_length(p, role: str) -> float:
 def make_links(p) -> dict:
     """Four-bar: ``{"crank": None, "rods": None, "links": {role: body}, "files": {role: path}}``
     from the validated ``[dynamics.flexible]`` link tables (a file, or a bar reduced here)."""
-    from ..errors import InputFileError
-    from .flexbuild import link_body, reduced_bar
-    from .scene_keys import FOUR_BAR_LINKS
+    from ...errors import InputFileError
+    from ..flexible.build import link_body, reduced_bar
+    from .keys import FOUR_BAR_LINKS
 
     out = {"crank": None, "rods": None, "links": {}, "files": {}}
     for role in FOUR_BAR_LINKS:
@@ -115,15 +115,15 @@ def make_bodies(p, mechanism_params=None) -> dict | None:
     Returns ``{"crank": (body, roles) or None, "rods": [body per cylinder] or None,
     "files": {name: path}}``; for the four-bar :func:`make_links`.
     """
-    from .flexbuild import crank_body, read, rod_body
-    from .scene_keys import flexible_keys
+    from ..flexible.build import crank_body, read, rod_body
+    from .keys import flexible_keys
 
     flex = p["flexible"]
     if not flexible_keys(p):
         return None
     if p["mechanism"] == "four_bar":
         return make_links(p)
-    from ..errors import InputFileError
+    from ...errors import InputFileError
 
     radius, lengths, rows = train_geometry(p, mechanism_params)
     machine = p.get("machine")
@@ -153,7 +153,7 @@ def make_bodies(p, mechanism_params=None) -> dict | None:
 
 def rigid_twins(bodies: dict) -> dict:
     """The same bodies with their modes frozen (:func:`.flexbuild.rigid_twin`)."""
-    from .flexbuild import rigid_twin
+    from ..flexible.build import rigid_twin
 
     out = {"crank": None, "rods": None}
     if bodies.get("links"):
@@ -182,7 +182,7 @@ def _rms(x):
 
 def force_comparison(t, f_flex, f_rigid, rev_hz, orders) -> dict:
     """Peak, RMS and order amplitudes of a force (K, 2) flexible vs rigid, and their difference."""
-    from .signals import order_amplitudes
+    from ..results.signals import order_amplitudes
 
     mf, mr = np.hypot(*f_flex.T), np.hypot(*f_rigid.T)
     diff = np.hypot(*(f_flex - f_rigid).T)
@@ -218,8 +218,8 @@ def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict 
     reduction at the mesh nodes); the rigid tilts carry no stress. Returns None when the file
     holds no stress modes.
     """
-    from ..reduction.io import load_flexbody
-    from ..reduction.stress_modes import von_mises
+    from ...reduction.io import load_flexbody
+    from ...reduction.stress_modes import von_mises
 
     fb = body.source if body.source is not None else load_flexbody(body.info["file"])
     modes = getattr(fb, "stress_modes", None)
@@ -257,9 +257,9 @@ def flexible_results(mech, hist, rigid_hist, sel, rev_hz, bodies, warnings=None)
     go to ``warnings``, a list, as :func:`crankmodal.errors.warn` does) and
     ``effective_damping`` (its lowest mode with its joints pinned, :mod:`.modal_damping`).
     """
-    from ..errors import warn
-    from .modal_damping import effective_damping
-    from .validity import elastic_deflection, flexible_validity
+    from ...errors import warn
+    from ..flexible.modal_damping import effective_damping
+    from ..results.validity import elastic_deflection, flexible_validity
 
     t = hist.t[sel]
     orders = list(range(13))

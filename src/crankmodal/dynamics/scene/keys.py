@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 
-from ..errors import SceneError
-from ..schema import Field, validate
-from . import contact
-from .clearance import FILM_MODELS
+from ...errors import SceneError
+from ...schema import Field, validate
+from ..laws import contact
+from ..model.clearance import FILM_MODELS
 
 MECHANISMS = ("slider_crank", "four_star", "four_bar")
 METHODS = ("auto", "LSODA", "Radau", "BDF", "RK45", "DOP853")
@@ -281,14 +281,14 @@ def validate_section(raw: dict) -> dict:
     p["flexible"] = validate_flexible(p["flexible"], p["mechanism"])
     _cross_checks(p)
     if p["mechanism"] == "four_bar":  # a bar reduced here: its size refused before it is meshed
-        from .flexbuild import check_bar
+        from ..flexible.build import check_bar
 
         for length, role in zip(p["four_bar"]["lengths"], FOUR_BAR_LINKS):
             spec = p["flexible"].get(role)
             if spec is not None and spec["bar"] is not None:
                 check_bar(float(length), spec["bar"], spec, f"dynamics.flexible.{role}")
     elif isinstance(p.get("machine"), str):  # a machine's part reduced here: checked likewise
-        from .flexbuild import check_part
+        from ..flexible.build import check_part
 
         for key, part in (("crank", "crankshaft"), ("rods", "rod")):
             spec = p["flexible"].get(key)
@@ -362,7 +362,7 @@ def _cross_checks(p):
     if cont["law"] == "kelvin_voigt" and cont["stiffness"] is None and p["clearances"]:
         # the default from E, nu and the radii is the Hertz constant (N/m^1.5) of the power
         # laws: as a linear K (N/m) it would be a unit error
-        from .contact import cylinder_stiffness
+        from ..laws.contact import cylinder_stiffness
 
         c0 = p["clearances"][0]
         r = c0["journal_radius"]

@@ -17,8 +17,8 @@ REQUIRES = ()
 def validate(raw: dict, scene) -> dict:
     from pathlib import Path
 
-    from ..errors import SceneError
-    from .scene_keys import check_speed, flexible_keys, validate_section
+    from ...errors import SceneError
+    from .keys import check_speed, flexible_keys, validate_section
 
     p = validate_section(raw)
     for key in flexible_keys(p):
@@ -42,8 +42,8 @@ def validate(raw: dict, scene) -> dict:
 
 def _build(build, p, mechanism_params, bodies, twin=False):
     """``build(p, mechanism_params, bodies)``, redundant joints relabelled with the scene key."""
-    from ..errors import SceneError
-    from .mechanisms import RedundantJoints
+    from ...errors import SceneError
+    from ..model.mechanisms import RedundantJoints
 
     try:
         return build(p, mechanism_params, bodies)
@@ -83,12 +83,12 @@ def _start_warning(mech, p, rev_hz) -> str | None:
 def _probe_flexbody(key: str, spec: dict, p=None) -> None:
     """Read a given flexbody file before any stage runs: format, version, modes asked (and for
     a four-bar link its interfaces and their distance)."""
-    from ..errors import InputFileError, SceneError
-    from .flexible import load_flexible_body
+    from ...errors import InputFileError, SceneError
+    from ..flexible.body import load_flexible_body
 
     try:
         if p is not None and p["mechanism"] == "four_bar":
-            from .flexbuild import link_body
+            from ..flexible.build import link_body
             from .flexstage import body_keys, link_length
 
             with body_keys(key):
@@ -104,7 +104,7 @@ def _probe_flexbody(key: str, spec: dict, p=None) -> None:
 
 def short_contact_warning(cj, duration: float, dt: float) -> str:
     """The warning for contacts shorter than two output steps: the sampled histories miss them."""
-    from .contact import cylinder_stiffness
+    from ..laws.contact import cylinder_stiffness
 
     text = (f"dynamics: the contacts of joint {cj.name!r} last {duration:.2g} s (median), "
             f"under two output steps ({dt:.2g} s): the sampled force histories and the "
@@ -123,7 +123,7 @@ def short_contact_warning(cj, duration: float, dt: float) -> str:
 def _window(hist, p, rev_hz):
     """Sample mask of the results window (:func:`.stats.results_window`: whole revolutions
     after the start-up), its number of revolutions and whether it had to include the start-up."""
-    from .stats import results_window
+    from ..results.stats import results_window
 
     t0, t1, n_rev, start_up = results_window(hist.t, p["ramp_time"], p["spectrum_start"], rev_hz)
     return (hist.t >= t0 - 1e-12) & (hist.t <= t1 + 1e-12), n_rev, start_up
@@ -141,12 +141,9 @@ def _start_up_warning(p, rev_hz) -> str:
 def run(params: dict, ctx) -> dict:
     from dataclasses import replace
 
-    from ..errors import warn
-    from ..results import atomic_path
-    from . import timescales
-    from .analysis import key_outputs, simulate, tolerance_study
-    from .build import build_mechanism, solver_settings
-    from .signals import (
+    from ...errors import warn
+    from ...results import atomic_path
+    from ..results.signals import (
         amplitude_spectrum,
         contact_durations,
         contact_loss_indicator,
@@ -154,12 +151,15 @@ def run(params: dict, ctx) -> dict:
         impact_statistics,
         order_amplitudes,
     )
-    from .stats import converged_summary, statistics
-    from .validity import penetration_warning
+    from ..results.stats import converged_summary, statistics
+    from ..results.validity import penetration_warning
+    from ..run import timescales
+    from ..run.simulate import key_outputs, simulate, tolerance_study
+    from .build import build_mechanism, solver_settings
 
     p = params
     bodies = None
-    from .scene_keys import flexible_keys
+    from .keys import flexible_keys
 
     if flexible_keys(p):
         from .flexstage import make_bodies
@@ -180,8 +180,8 @@ def run(params: dict, ctx) -> dict:
 
         for text in truncation_warnings(p, bodies):
             warn(text, into=early_warnings)
-    from ..errors import scene_keys
-    from .budget import check as check_budget
+    from ...errors import scene_keys
+    from ..run.budget import check as check_budget
 
     with scene_keys("dynamics"):  # refuse what cannot finish (contact.damping: ... -> dynamics.)
         for text in check_budget(mech, t_end, settings)[1]:
@@ -275,12 +275,12 @@ def run(params: dict, ctx) -> dict:
     v_min = {cj.name: cj.v_impact_min for cj in mech.system.clearances}
     res["statistics"] = statistics(hist, rev_hz, float(hist.t[sel][0]), v_min)
     if p["ensemble"] > 1:
-        from .ensemble import run_ensemble
+        from ..run.ensemble import run_ensemble
 
         res["ensemble"] = run_ensemble(mech, res["statistics"], p["ensemble"], t_end, dt,
                                        settings, rev_hz, float(hist.t[sel][0]), v_min,
                                        energy_tolerance=tol)
-    from .ensemble import headlines
+    from ..run.ensemble import headlines
 
     res["headline"] = headlines(res["statistics"], res.get("ensemble"))
     if ideal is not None:  # the same window as the run with clearance
@@ -303,8 +303,8 @@ def run(params: dict, ctx) -> dict:
                                            warnings=res["warnings"])
         res["flexible"]["rigid_integration_wall_time_s"] = None if rigid is None else rigid.wall_time
         res["flexible"]["start"] = {"state": p["flexible"]["start"], **(start_info or {})}
+        from ..flexible.stepbound import step_bound
         from .flexstage import flexible_bodies_of
-        from .stepbound import step_bound
 
         bound = step_bound(flexible_bodies_of(mech), settings.method, t_end, hist.nfev,
                            key_of=_flexible_key)
@@ -338,7 +338,7 @@ def run(params: dict, ctx) -> dict:
     if ctx.figures:
         res["figures"] = _figures(hist, ideal, mech, sel, study, out, spec)
         if bodies is not None:
-            from .flexplots import flexible_figures
+            from ..results.flexplots import flexible_figures
 
             res["flexible"]["figures"] = flexible_figures(hist, rigid, mech, sel, out)
             res["figures"] += res["flexible"]["figures"]
@@ -348,12 +348,12 @@ def run(params: dict, ctx) -> dict:
         motion = f"piston accel peak {k['peak_piston_acceleration']:.4g} m/s^2"
     else:
         motion = f"rocker accel peak {res['angular_acceleration_peak'].get('rocker', 0.0):.4g} rad/s^2"
-    from ..report.quantity import number, quantity  # never e+NN in a summary (issue 25 #15)
+    from ...report.quantity import number, quantity  # never e+NN in a summary (issue 25 #15)
 
     if "ensemble" in res and n_rev >= 1 and study is None:
         # one value per quantity, with the ensemble's spread where the trajectories disagree
         # (with a tolerance study: its convergence summary over the ensemble, below)
-        from .ensemble import headline_text as ensemble_text
+        from ..run.ensemble import headline_text as ensemble_text
 
         headline_text = ensemble_text(res["headline"], n_rev)
     elif mech.system.clearances and res["statistics"]["window"]["n_revolutions"] >= 2:
@@ -371,7 +371,7 @@ def run(params: dict, ctx) -> dict:
             res["summary"] += (f"; {name} oil film: thinnest {1e6 * j['min_film_thickness_m']:.3g}"
                                f" um (eccentricity ratio {j['eccentricity_ratio_max']:.3g})")
     if "ensemble" in res:
-        from ..report.quantity import quantity_range  # 15.99–34.56 kN, not 1.599e+04-3.456e+04
+        from ...report.quantity import quantity_range  # 15.99–34.56 kN, not 1.599e+04-3.456e+04
 
         e = res["headline"]["main_bearing_per_rev_peak_n"]
         res["summary"] += (f"; the {p['ensemble']} trajectories (started 10⁻¹² apart) range "
@@ -379,7 +379,7 @@ def run(params: dict, ctx) -> dict:
     if bodies is not None:
         names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in res["flexible"]["bodies"].items())
         res["summary"] += f"; flexible: {names}"
-        from .validity import validity_summary
+        from ..results.validity import validity_summary
 
         res["summary"] += validity_summary(res["flexible"]["bodies"])
         cmp = res["flexible"].get("rigid", {}).get("main_bearing")
@@ -404,8 +404,8 @@ def _flexible_key(body_name: str) -> str:
 
 def _figures(hist, ideal, mech, sel, study, out, spec=None):
     """Write the PNG figures; ``spec``: the main-bearing spectrum if already computed."""
-    from . import plots
-    from .signals import amplitude_spectrum
+    from ..results import plots
+    from ..results.signals import amplitude_spectrum
 
     figs = []
     rev = mech.revolution_hz
