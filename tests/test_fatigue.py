@@ -226,3 +226,17 @@ def test_a_truncated_or_missing_file_is_refused_naming_it(tmp_path):
     assert exc.value.member == "format"
     with pytest.raises(InputFileError, match="not found"):
         FatigueResult.load(tmp_path / "absent.npz")
+
+
+def test_library_fatigue_strengths_lie_in_the_handbook_fatigue_ratio_band():
+    """Fully reversed fatigue strength of steels and nodular irons: 0.3-0.6 of the ultimate
+    (Shigley Fig. 6-17; EN 1563's GJS grades 0.4-0.5); the three crank materials have it."""
+    from crankmodal.fem.materials import library
+
+    have = [n for n in library() if material(n).fatigue_strength is not None]
+    assert {"42CrMo", "crank_steel_seed000", "SG 700/2"} <= set(have)
+    for name in have:
+        m = material(name)
+        assert 0.3 <= m.fatigue_strength / m.ultimate_strength <= 0.6, name
+        assert m.torsional_fatigue_strength == pytest.approx(m.fatigue_strength / math.sqrt(3))
+    assert material("SG 700/2").to_dict()["fatigue_strength_pa"] == 280e6
