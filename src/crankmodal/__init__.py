@@ -100,6 +100,7 @@ _EXPORTS: dict[str, tuple[str, str]] = {
     "Revolute": ("crankmodal.dynamics.model.joints", "Revolute"),
     "Prismatic": ("crankmodal.dynamics.model.joints", "Prismatic"),
     "ClearanceJoint": ("crankmodal.dynamics.model.clearance", "ClearanceJoint"),
+    "ClearanceSpec": ("crankmodal.dynamics.model.clearance", "ClearanceSpec"),
     "NormalLaw": ("crankmodal.dynamics.laws.objects", "NormalLaw"),
     "FrictionLaw": ("crankmodal.dynamics.laws.objects", "FrictionLaw"),
     "make_law": ("crankmodal.dynamics.laws.objects", "make_law"),
@@ -120,6 +121,7 @@ _EXPORTS: dict[str, tuple[str, str]] = {
 __all__ = [
     "ChainModes",
     "ClearanceJoint",
+    "ClearanceSpec",
     "ConrodParams",
     "CrankModel",
     "CrankmodalError",

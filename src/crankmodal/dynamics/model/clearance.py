@@ -14,10 +14,117 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from ...errors import ParameterError
+from ...schema import REQUIRED, Field
 from ..laws import objects as laws
 from ..laws.lubrication import film_arguments, short_film
 
 FILM_MODELS = ("short", "finite")
+
+#: the rules of a clearance joint's geometry and film arguments (the ``[[dynamics.clearances]]``
+#: scene keys take theirs from here)
+RULES = {
+    "clearance": Field("float", REQUIRED, "radial clearance, m", gt=0.0, le=0.01),
+    "journal_radius": Field("float", REQUIRED, "journal radius, m", gt=0.0),
+    "clearance_major": Field("float", None, "radial clearance along the major axis of a worn "
+                             "(elliptical) bore, m", gt=0.0, le=0.01),
+    "wear_angle": Field("float", 0.0, "direction of the worn bore's major axis, rad"),
+    "viscosity": Field("float", None, "lubricant dynamic viscosity, Pa s", gt=0.0),
+    "bearing_length": Field("float", None, "bearing length for the film force, m", gt=0.0),
+    "film_model": Field("str", "short", "film force: short (Ocvirk) or finite (Reynolds)",
+                        choices=FILM_MODELS),
+    "v_impact_min": Field("float", 1e-3, "floor of the impact velocity, m/s", gt=0.0),
+}
+
+
+@dataclass(frozen=True)
+class ClearanceSpec:
+    """What makes a joint a clearance joint: the bore, the journal, the laws and the film.
+
+    The typed description a mechanism builder (:func:`~.mechanisms.crank_train`,
+    :func:`~.mechanisms.four_bar`) turns into a :class:`ClearanceJoint` between two bodies
+    (:meth:`joint`). The constructor checks every field and raises
+    :class:`~crankmodal.errors.ParameterError` naming it.
+
+    Parameters
+    ----------
+    clearance : float
+        Radial clearance ``c = R_bearing - R_journal``, m, in (0, 0.01]; the minor-axis one of a
+        worn bore.
+    journal_radius : float
+        m, > 0.
+    normal : NormalLaw
+        Normal contact force law (:mod:`..laws.objects`, e.g. ``Impact(...)``).
+    friction : FrictionLaw
+        Friction law (default :class:`~..laws.objects.NoFriction`).
+    v_impact_min : float
+        Floor of the impact velocity of the restitution laws, m/s, > 0.
+    clearance_major : float or None
+        Radial clearance along the major axis of a worn (elliptical) bore, m, >= ``clearance``;
+        None for a round bore.
+    wear_angle : float
+        Direction of that major axis in the bearing body's frame, rad.
+    viscosity : float or None
+        Lubricant dynamic viscosity, Pa s (round bores only); None for a dry joint.
+    bearing_length : float or None
+        Bearing length, m: required with ``viscosity``; None or 0 without a film.
+    film_model : str
+        ``"short"`` (Ocvirk) or ``"finite"`` (Reynolds, tabulated per L/D).
+
+    Examples
+    --------
+    >>> from crankmodal.dynamics.laws.objects import Impact
+    >>> spec = ClearanceSpec(1e-4, 0.02, Impact(stiffness=1e10, damping=300.0,
+    ...                                         penetration=1e-4))
+    >>> spec.friction.name
+    'none'
+    """
+
+    clearance: float
+    journal_radius: float
+    normal: laws.NormalLaw
+    friction: laws.FrictionLaw = laws.NoFriction()
+    v_impact_min: float = 1e-3
+    clearance_major: float | None = None
+    wear_angle: float = 0.0
+    viscosity: float | None = None
+    bearing_length: float | None = None
+    film_model: str = "short"
+
+    def __post_init__(self):
+        from ... import arguments as arg
+
+        for name, rule in RULES.items():
+            value = getattr(self, name)
+            if name == "bearing_length" and value == 0.0:  # 0: no film (the API's old default)
+                value = None
+            object.__setattr__(self, name, arg.check(name, value, rule,
+                                                     optional=rule.default is not REQUIRED))
+        arg.instance("normal", self.normal, laws.NormalLaw, "a NormalLaw (e.g. Impact(...), "
+                     "or make_law(name, params))")
+        arg.instance("friction", self.friction, laws.FrictionLaw, "a FrictionLaw (e.g. "
+                     "Coulomb(...), NoFriction(), or make_friction(name, params))")
+        if self.clearance_major is not None and self.clearance_major < self.clearance:
+            raise ParameterError("clearance_major", f"must be >= clearance "
+                                 f"({self.clearance:g} m), got {self.clearance_major:g}")
+        if self.viscosity is not None and self.bearing_length is None:
+            raise ParameterError("bearing_length", "is required with viscosity (bearing "
+                                 "length, m, > 0)")
+        if self.viscosity is not None and self.clearance_major is not None:
+            raise ParameterError("viscosity", "the film model needs a round bore; give "
+                                 "clearance_major or viscosity, not both")
+
+    def joint(self, name: str, journal, journal_frame: str, bearing,
+              bearing_frame: str) -> ClearanceJoint:
+        """The clearance joint ``name`` between ``journal`` (the pin at ``journal_frame``) and
+        ``bearing`` (the bore at ``bearing_frame``)."""
+        return ClearanceJoint(
+            name=name, journal=journal, journal_frame=journal_frame, bearing=bearing,
+            bearing_frame=bearing_frame, clearance=self.clearance,
+            journal_radius=self.journal_radius, law=self.normal, friction=self.friction,
+            v_impact_min=self.v_impact_min, clearance_major=self.clearance_major,
+            wear_angle=self.wear_angle, viscosity=self.viscosity,
+            bearing_length=self.bearing_length or 0.0, film_model=self.film_model)
 
 
 @dataclass
