@@ -240,3 +240,25 @@ def test_library_fatigue_strengths_lie_in_the_handbook_fatigue_ratio_band():
         assert 0.3 <= m.fatigue_strength / m.ultimate_strength <= 0.6, name
         assert m.torsional_fatigue_strength == pytest.approx(m.fatigue_strength / math.sqrt(3))
     assert material("SG 700/2").to_dict()["fatigue_strength_pa"] == 280e6
+
+
+def test_out_of_phase_bending_and_torsion_is_flagged_non_proportional(oracle):
+    """sigma_xx = s sin t, tau_xy = (s / sqrt 3) cos t: the von Mises stress of sigma(t) stays
+    s all cycle, while the component-wise amplitude's is sqrt(2) s: proportionality 1/sqrt(2)
+    (closed form), warned at the worst point; in phase it is 1."""
+    s = 150e6
+    S = np.zeros((1, 6, 2))
+    S[0, 0, 0], S[0, 5, 1] = s, s / math.sqrt(3.0)
+    out = np.vstack([np.sin(CYCLE), np.cos(CYCLE)])
+    notes = []
+    with pytest.warns(UserWarning, match="non-proportional"):
+        res = fatigue_verdict(S, out, STEEL, np.zeros((1, 3)), warnings=notes)
+    oracle(stage="fem", quantity="proportionality of bending and torsion 90 deg out of phase",
+           reference="closed form 1/sqrt(2)", tolerance="1e-6 relative (360 steps)",
+           measured=res.proportionality[0], expected=1 / math.sqrt(2.0))
+    assert res.proportionality[0] == pytest.approx(1 / math.sqrt(2.0), rel=1e-6)
+    assert res.alternating[0] == pytest.approx(math.sqrt(2.0) * s, rel=1e-6)
+    inphase = fatigue_verdict(S, np.vstack([np.sin(CYCLE), np.sin(CYCLE)]), STEEL,
+                              np.zeros((1, 3)))
+    assert inphase.proportionality[0] == pytest.approx(1.0, rel=1e-12)
+    assert not inphase.warnings

@@ -21,7 +21,7 @@ from ..errors import InputFileError
 FORMAT = "crankmodal-fatigue"
 VERSION = 1
 #: per-point float arrays of the file; the NaN-allowed one (no yield strength) separately
-_PER_POINT = ("safety_factor", "alternating", "mean", "max_von_mises")
+_PER_POINT = ("safety_factor", "alternating", "mean", "max_von_mises", "proportionality")
 
 
 class FatigueFileError(InputFileError):
@@ -59,6 +59,10 @@ class FatigueResult:
         Largest von Mises stress over the cycle, Pa.
     yield_safety_factor : ndarray, shape (n,)
         ``yield_strength / max_von_mises`` (NaN without a yield strength).
+    proportionality : ndarray, shape (n,)
+        Largest von Mises stress of ``σ(t) − σ_m`` over that of the component-wise amplitude,
+        in (0, 1]: 1 for proportional loading; below it the component-wise amplitude
+        over-estimates the stress range (the verdict is conservative by up to its inverse).
     location_names, location_kinds : list of str
         The named locations (fillets, oil-hole exits) and their kinds.
     label : ndarray of int, shape (n,)
@@ -80,6 +84,7 @@ class FatigueResult:
     mean: np.ndarray
     max_von_mises: np.ndarray
     yield_safety_factor: np.ndarray
+    proportionality: np.ndarray
     location_names: list
     location_kinds: list
     label: np.ndarray
@@ -107,7 +112,7 @@ class FatigueResult:
                 "point_m": self.points[i].tolist(), "alternating_pa": float(self.alternating[i]),
                 "mean_pa": float(self.mean[i]), "max_von_mises_pa": float(self.max_von_mises[i]),
                 "yield_safety_factor": float(self.yield_safety_factor[i]),
-                "n_points": int(np.sum(mask))}
+                "proportionality": float(self.proportionality[i]), "n_points": int(np.sum(mask))}
 
     def locations(self) -> dict:
         """Per named location (and ``elsewhere``: the other points assessed) its worst point:
@@ -274,10 +279,15 @@ def _read(path: Path) -> FatigueResult:
         if n <= 0 or nodes.min() < 0:
             raise _fail(path, "nodes", "must be one or more point indices >= 0")
         arrays = {k: numbers(k, (n,), inf_ok=(k == "safety_factor")) for k in _PER_POINT}
-        if np.any(arrays["safety_factor"] <= 0) or np.any(arrays["alternating"] < 0) \
-                or np.any(arrays["max_von_mises"] < 0):
-            raise _fail(path, "safety_factor", "safety factors must be > 0 and the alternating "
-                                               "and von Mises stresses >= 0")
+        for name, ok in (("safety_factor", arrays["safety_factor"] > 0),
+                         ("alternating", arrays["alternating"] >= 0),
+                         ("max_von_mises", arrays["max_von_mises"] >= 0),
+                         ("proportionality", (arrays["proportionality"] >= 0)
+                          & (arrays["proportionality"] <= 1))):
+            if not np.all(ok):
+                raise _fail(path, name, f"holds {int((~ok).sum())} value(s) out of range "
+                                        f"(safety factor > 0, stresses >= 0, proportionality "
+                                        f"in [0, 1])")
         ny = numbers("yield_safety_factor", (n,), nan_ok=True, inf_ok=True)
         label = numbers("label", (n,), "iu")
         if np.any((label < -1) | (label >= len(names))):

@@ -25,6 +25,9 @@ from .cycle import MEMORY_BYTES, cycle_extremes
 from .factors import FatigueFactors
 from .result import FatigueResult
 
+#: below this proportionality at the worst point the verdict warns (see FatigueResult)
+PROPORTIONAL = 0.95
+
 
 def _strengths(material):
     from ..fem.materials import Material
@@ -138,6 +141,16 @@ def fatigue_verdict(stress_modes, modal_coordinates, material, points, *, nodes=
     sm = kf * equivalent_mean(mean, mean_stress)
     se = factors.corrected(mat.fatigue_strength)
     n = safety_factor(sa, sm, se, mat.ultimate_strength, rule)
+    vm_amp = sa / kf
+    with np.errstate(divide="ignore", invalid="ignore"):
+        prop = np.where(vm_amp > 0, np.minimum(ext.max_deviation_von_mises / vm_amp, 1.0), 1.0)
+    w = int(np.argmin(n))
+    if prop[w] < PROPORTIONAL:
+        warn(f"fatigue: the loading at the worst point ({pts[idx[w]].round(5).tolist()} m) is "
+             f"non-proportional: the largest von Mises stress of sigma(t) - sigma_m is "
+             f"{prop[w]:.3g} of that of the component-wise amplitude, so the verdict there is "
+             f"conservative by up to {1 / prop[w]:.3g}x (a critical-plane criterion would tell)",
+             notes)
     if mat.yield_strength is not None:
         with np.errstate(divide="ignore"):
             ny = np.where(ext.max_von_mises > 0, mat.yield_strength / ext.max_von_mises, np.inf)
@@ -161,7 +174,7 @@ def fatigue_verdict(stress_modes, modal_coordinates, material, points, *, nodes=
         warnings.extend(notes)
     return FatigueResult(
         nodes=idx, points=pts[idx], safety_factor=n, alternating=sa, mean=sm,
-        max_von_mises=ext.max_von_mises, yield_safety_factor=ny,
+        max_von_mises=ext.max_von_mises, yield_safety_factor=ny, proportionality=prop,
         location_names=names, location_kinds=kinds, label=label,
         fatigue_strength=se, specimen_fatigue_strength=mat.fatigue_strength,
         ultimate_strength=mat.ultimate_strength,

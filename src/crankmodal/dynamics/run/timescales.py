@@ -102,7 +102,7 @@ def effective_mass(sysm, cj, q, qd) -> float:
     """
     n = sysm.n
     M = sysm.mass_matrix(q)
-    _, Cq, _, _ = sysm.generic_constraint_terms(0.0, q, qd)
+    _, Cq, _, _ = sysm.constraint_terms(0.0, q, qd)
     A = np.zeros((n + sysm.m, n + sysm.m))
     A[:n, :n] = M
     A[:n, n:] = Cq.T
