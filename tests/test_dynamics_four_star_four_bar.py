@@ -127,15 +127,16 @@ def test_loom_coupler_pin_clearance_orbit_stays_near_the_clearance_circle():
     assert h.energy_error() < 1e-4
 
 
-def test_vectorised_constraint_terms_equal_the_joint_by_joint_assembly(star_ideal):
-    # The fast path must reproduce the generic per-joint blocks at an arbitrary (inconsistent) state.
+def test_compiled_constraint_terms_equal_the_joint_by_joint_assembly(star_ideal):
+    # The kernel's constraint values and Jacobian must reproduce the reference path's per-joint
+    # blocks at an arbitrary (inconsistent) state.
     m, _ = star_ideal
     for sysm in (m.ideal, m.system, four_bar(**LOOM).ideal):
         rng = np.random.default_rng(1)
         q = rng.normal(size=sysm.n)
         qd = rng.normal(size=sysm.n)
-        fast = sysm.constraint_terms(0.013, q, qd)
-        slow = sysm.generic_constraint_terms(0.013, q, qd)
-        for a, b in zip(fast, slow):
-            # two numpy summation orders: round-off only, 1e-12 of the terms' size on any CPU
+        out = sysm.kernel().solve(0.013, q, qd)
+        phi, Cq, _, _ = sysm.constraint_terms(0.013, q, qd)
+        for a, b in ((out["phi"], phi), (out["Cq"], Cq)):
+            # two summation orders: round-off only, 1e-12 of the terms' size on any CPU
             np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * max(np.max(np.abs(b)), 1.0))

@@ -2,8 +2,8 @@
 
 For a system of rigid and planar flexible (floating-frame, modal) bodies joined by pins, sliders
 and angle drives, with clearance joints (round or worn elliptical bores, dry or with the
-short-bearing or the finite-length oil film; any law of :mod:`.laws`), piston loads (gas force and ring friction) and
-crank torques, :class:`CompiledSystem` evaluates what
+short-bearing or the finite-length oil film; any law of :mod:`.laws`), piston loads (gas force and ring friction),
+crank torques and torsional couplings, :class:`CompiledSystem` evaluates what
 :meth:`Multibody.solve` and :meth:`Multibody.rhs` evaluate in two Numba-compiled calls
 (``cache=True``: compiled once per machine, ~20 s, then loaded in ~1 s) around LAPACK's solve:
 :func:`assemble` (frame table, flexible-body terms, applied and contact forces, constraint terms
@@ -14,7 +14,7 @@ whole KKT system is solved. The Python path costs ~0.25 ms (rigid four-star with
 joint) to ~1 ms (flexible) per evaluation in some hundred small NumPy calls; this one ~0.02 ms
 (rigid) to ~0.05 ms (flexible crank with 20 modes and rod with 14).
 
-The formulas are those of :mod:`.system`, :mod:`.fastpath`, :mod:`.flexible`, :mod:`.clearance`,
+The formulas are those of :mod:`.system`, :mod:`.flexible`, :mod:`.clearance`,
 :mod:`.contact` and :mod:`.loads`, written out per scalar; the results agree to round-off (the
 tests compare both paths state by state). The worn bore's clearance
 (:func:`.clearance.worn_bore_clearance`) and the short-bearing film
@@ -30,17 +30,34 @@ restitution laws are the integrator's state, passed at every call.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
-from scipy.linalg.lapack import dgesv as _gesv
+from numba import njit, types
 
 from ..flexible.body import FlexibleBody
 from ..laws.lubrication import film_arguments, short_film
 from ..laws.reynolds import film_spline, finite_film
 from ..model.bodies import Ground, RigidBody
 from ..model.clearance import ClearanceJoint, worn_bore_clearance
-from ..model.fastpath import frames_of
-from ..model.joints import AngleDrive, Prismatic, Revolute
-from ..model.loads import CrankTorque, PistonLoads
+from ..model.joints import AngleDrive, Prismatic, Revolute, SpeedProfile, frames_of, speed_profile
+from ..model.loads import CrankTorque, PistonLoads, TorsionalCoupling
+
+
+
+def _lapack_symbol(name: str) -> str:
+    """Register LAPACK's ``name`` (SciPy's ``cython_lapack``) with LLVM under a fixed symbol and
+    return it: compiled code calls it by that symbol, resolved when the code is loaded, so the
+    on-disk cache holds no process-specific address (a ctypes pointer would defeat it)."""
+    import llvmlite.binding as llvm
+    from numba.extending import get_cython_function_address
+
+    symbol = f"crankmodal_{name}"
+    llvm.add_symbol(symbol, get_cython_function_address("scipy.linalg.cython_lapack", name))
+    return symbol
+
+
+_I32P, _F64P = types.CPointer(types.int32), types.CPointer(types.float64)
+#: LAPACK dgesv(n, nrhs, a, lda, ipiv, b, ldb, info), the solve of np.linalg.solve
+_dgesv = types.ExternalFunction(_lapack_symbol("dgesv"),
+                                types.void(_I32P, _I32P, _F64P, _I32P, _I32P, _F64P, _I32P, _I32P))
 
 #: per clearance joint diagnostics written by the kernel (columns of ``diag``)
 DIAG = ("ex", "ey", "nx", "ny", "d", "delta", "delta_dot", "v_slip", "fn", "ft", "fx", "fy",
@@ -77,7 +94,7 @@ def applicable(sysm) -> bool:
         if not all(isinstance(b, (*_BODIES, Ground)) for b in (cj.journal, cj.bearing)):
             return False
     for ld in sysm.loads:
-        if type(ld) not in (PistonLoads, CrankTorque):
+        if type(ld) not in (PistonLoads, CrankTorque, TorsionalCoupling):
             return False
         if not all(isinstance(b, _BODIES) for b in (getattr(ld, "piston", ld.crank), ld.crank)):
             return False
@@ -359,11 +376,12 @@ def _flexible(q, qd, fb_int, fb_f, Q, A):
 #: order of the integer tables packed into ``I`` (see :class:`CompiledSystem`)
 INT_TABLES = ("fcol", "fmn", "fmoff", "fadoff", "rev_rows", "rev_a", "rev_b", "pri_rows",
               "pri_k", "drive_rows", "drive_k", "cl_int", "pl_int", "gas_off", "tq_k",
-              "is_drive", "col_ptr", "col_rows", "massless", "fb_int", "full", "film_off")
+              "is_drive", "col_ptr", "col_rows", "massless", "fb_int", "full", "film_off",
+              "cp_k")
 #: order of the float tables packed into ``F``
 FLOAT_TABLES = ("floc", "fmodal", "mdiag", "Q0", "pri_n", "pri_o", "pri_ang", "cl_f", "law_vec",
                 "fric_vec", "pl_f", "gas_x", "gas_f", "gas_period", "tq_val", "baumgarte",
-                "fb_f", "film_spl")
+                "fb_f", "film_spl", "cp_f")
 
 
 @njit(cache=True)
@@ -488,6 +506,15 @@ def assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q,
     for i in range(tq_k.size):
         _add_force(Q2, fr, arm, tq_k[i], 0.0, 0.0, tq_val[i])
         p_loads += tq_val[i] * vel[tq_k[i], 2]
+    # torsional couplings (loads.TorsionalCoupling): T on frame a, -T on frame b
+    cp_k, cp_f = _seg(I, io, 22).reshape((-1, 2)), _seg(F, fo, 18).reshape((-1, 3))
+    for i in range(cp_k.shape[0]):
+        ka, kb = cp_k[i, 0], cp_k[i, 1]
+        wa, wb = vel[ka, 2], vel[kb, 2]
+        tq = cp_f[i, 0] * (pose[kb, 2] - pose[ka, 2] - cp_f[i, 2]) + cp_f[i, 1] * (wb - wa)
+        _add_force(Q2, fr, arm, ka, 0.0, 0.0, tq)
+        _add_force(Q2, fr, arm, kb, 0.0, 0.0, -tq)
+        p_loads += tq * (wa - wb)
     # constraint terms (the joints' blocks: pins, sliders on a ground line, angle drives)
     nu = np.zeros(m)
     gamma = np.zeros(m)
@@ -609,6 +636,40 @@ def finish(sol, Q, Cq, cqd, I, io, F, fo, qdd, lam, powers):
 
 
 @njit(cache=True)
+def drive_values(t, drv, dv):
+    """Per angle drive its (angle, speed, acceleration) at ``t`` into ``dv`` (rad, rad/s,
+    rad/s^2) from ``drv``, rows of :meth:`.SpeedProfile.table`."""
+    for i in range(drv.shape[0]):
+        dv[i, 0], dv[i, 1], dv[i, 2] = speed_profile(t, drv[i, 0], drv[i, 1], drv[i, 2],
+                                                     drv[i, 3])
+
+
+@njit(cache=True)
+def evaluate(t, q, qd, dv, vimp, gas_py, tabs, work, phi, Cq, diag, powers, qdd, lam):
+    """One right-hand side: :func:`assemble`, LAPACK's ``dgesv`` in place, :func:`finish`.
+
+    ``tabs = (I, io, F, fo)``; ``work = (Q, cqd, A, rhs, ipiv, ints)`` (:class:`CompiledSystem`
+    allocates them; ``ints``: three int32). Returns 0, 1 (a non-finite result) or 2 (a singular
+    matrix). The Python-called path (:meth:`CompiledSystem.rhs`) and the compiled integrator
+    loop (:mod:`.integrator`) both call this one function.
+    """
+    I, io, F, fo = tabs
+    Q, cqd, A, rhs, ipiv, ints = work
+    assemble(t, q, qd, dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers, Q, cqd, A, rhs)
+    # LAPACK gesv (as np.linalg.solve on the Python path), in place: compiling np.linalg.solve
+    # would cost 10 s more at the first run. A is symmetric, so its C-ordered storage is the
+    # Fortran-ordered A that gesv overwrites.
+    if rhs.size:
+        ints[0], ints[1], ints[2] = rhs.size, 1, 0
+        _dgesv(ints[0:].ctypes, ints[1:].ctypes, A.ctypes, ints[0:].ctypes, ipiv.ctypes,
+               rhs.ctypes, ints[0:].ctypes, ints[2:].ctypes)
+        if ints[2] != 0:  # > 0: an exactly zero pivot
+            return 2
+    ok = finish(rhs, Q, Cq, cqd, I, io, F, fo, qdd, lam, powers)
+    return 0 if ok else 1
+
+
+@njit(cache=True)
 def clearance_kinematics(j, q, qd, I, io, F, fo, out):
     """Penetration (``out[5]``) and its rate (``out[6]``) of clearance joint ``j`` only."""
     fr = _frame_tables(I, io, F, fo)
@@ -721,6 +782,10 @@ class CompiledSystem:
             if type(ld) is CrankTorque:
                 tq_k.append(key(ld.crank, ld.frame))
                 tq_val.append(ld.torque)
+        cp_k = [(key(ld.a, ld.frame_a), key(ld.b, ld.frame_b)) for ld in sysm.loads
+                if type(ld) is TorsionalCoupling]
+        cp_f = [(ld.stiffness, ld.damping, ld.offset) for ld in sysm.loads
+                if type(ld) is TorsionalCoupling]
         # bodies: diagonal masses (rigid bodies; x, y of flexible ones), constant forces, and
         # the flexible bodies' invariants
         mdiag = np.zeros(n)
@@ -766,12 +831,13 @@ class CompiledSystem:
                 "is_drive": sysm._drive_rows, "col_ptr": col_ptr,
                 "col_rows": np.concatenate(col_rows) if col_rows else [],
                 "massless": massless, "fb_int": fb_int, "full": [int(full)],
-                "film_off": film_off}
+                "film_off": film_off, "cp_k": cp_k}
         floats = {"floc": floc, "fmodal": fmodal, "mdiag": mdiag, "Q0": Q0,
                   "pri_n": pri_n, "pri_o": pri_o, "pri_ang": pri_ang, "cl_f": cl_f,
                   "law_vec": law_vec, "fric_vec": fric_vec, "pl_f": pl_f, "gas_x": gx,
                   "gas_f": gf, "gas_period": period, "tq_val": tq_val,
-                  "baumgarte": [sysm.baumgarte], "fb_f": fb_f, "film_spl": film_spl}
+                  "baumgarte": [sysm.baumgarte], "fb_f": fb_f, "film_spl": film_spl,
+                  "cp_f": cp_f}
         self.I, self.io = _pack([_flat(ints[k]) for k in INT_TABLES], np.int64)
         self.F, self.fo = _pack([_flat(floats[k]) for k in FLOAT_TABLES], float)
         self.gas_py = np.zeros(npl)
@@ -784,14 +850,25 @@ class CompiledSystem:
         self._scratch = (np.empty(m), np.empty(m), np.empty((m, n)), np.zeros(N_AUX))
         size = n + m if full else len(massless) + m
         self._size = size  # of the linear system: n + m with a flexible body
-        self._work = (np.empty(n), np.empty(m), np.zeros((size, size)), np.empty(size))
+        self._work = (np.empty(n), np.empty(m), np.zeros((size, size)), np.empty(size),
+                      np.zeros(size, np.int32), np.zeros(3, np.int32))
+        self.tabs = (self.I, self.io, self.F, self.fo)
+        # the drives' profiles as table rows (speed_profile's arguments), or None when one is
+        # not a SpeedProfile (its own methods are then called from Python)
+        profiles = [prof for _, _, prof in self.drives]
+        self.drv = (np.array([p.table() for p in profiles], float).reshape(-1, 4)
+                    if all(type(p) is SpeedProfile for p in profiles) else None)
+        self._dv = np.zeros((len(self.drives), 3))
 
     def _call(self, t, q, qd, qdd, lam, phi, Cq, diag, powers, v_impact=None):
         # one compiled specialisation: contiguous float arrays (a column of a history is not)
         q, qd = np.ascontiguousarray(q, float), np.ascontiguousarray(qd, float)
-        dv = np.empty((len(self.drives), 3))
-        for i, (_, _, prof) in enumerate(self.drives):
-            dv[i, 0], dv[i, 1], dv[i, 2] = prof.angle(t), prof.speed(t), prof.acceleration(t)
+        dv = self._dv
+        if self.drv is not None:
+            drive_values(float(t), self.drv, dv)
+        else:
+            for i, (_, _, prof) in enumerate(self.drives):
+                dv[i, 0], dv[i, 1], dv[i, 2] = prof.angle(t), prof.speed(t), prof.acceleration(t)
         if v_impact is None:
             for j, cj in enumerate(self.clearances):
                 self.vimp[j] = cj.v_impact
@@ -800,20 +877,18 @@ class CompiledSystem:
         for i, ld in self._py_gas:
             th = self.sysm.frame_pose_only(ld.crank, ld.crank_frame, q)[2]
             self.gas_py[i] = ld.gas_force(ld.sense * (th - ld.tdc_angle))
-        Q, cqd, A, rhs = self._work
-        assemble(t, q, qd, dv, self.vimp, self.gas_py, self.I, self.io, self.F, self.fo, phi, Cq,
-                 diag, powers, Q, cqd, A, rhs)
-        # LAPACK gesv (as np.linalg.solve on the Python path) through SciPy's thin wrapper, in
-        # place: compiling np.linalg.solve would cost 10 s more at the first run, and NumPy's
-        # own wrapper twice the time of this call. A is symmetric, so its transpose is the
-        # Fortran-ordered A that gesv overwrites without a copy.
-        if rhs.size:
-            _, _, sol, info = _gesv(A.T, rhs, overwrite_a=True, overwrite_b=True)
-            if info > 0:
-                raise np.linalg.LinAlgError("Singular matrix")
-        else:  # no constraints and every coordinate with mass: nothing to solve
-            sol = rhs
-        return finish(sol, Q, Cq, cqd, self.I, self.io, self.F, self.fo, qdd, lam, powers)
+        status = evaluate(float(t), q, qd, dv, self.vimp, self.gas_py, self.tabs, self._work, phi,
+                          Cq, diag, powers, qdd, lam)
+        if status == 2:
+            raise np.linalg.LinAlgError("Singular matrix")
+        return status == 0
+
+    @property
+    def loop_ready(self) -> bool:
+        """True when the whole right-hand side runs compiled (every drive a
+        :class:`.SpeedProfile`, no gas force given as a Python function): the compiled
+        integrator loop (:mod:`.integrator`) can then run this system."""
+        return self.drv is not None and not self._py_gas
 
     def rhs(self, t, y, v_impact=None):
         """``dy`` of :meth:`Multibody.rhs`; None if not finite."""
@@ -886,26 +961,23 @@ def _pack(arrays, dtype):
     return (np.concatenate(flat) if flat else np.zeros(0, dtype)), offsets
 
 
-def _flush_if_dependencies_changed() -> bool:
-    """Flush this module's Numba cache when a module whose jitted functions it calls changed.
+def flush_if_changed(namespace: dict, name: str, modules) -> bool:
+    """Flush the cached Numba functions of ``namespace`` (a module's ``globals()``, module
+    ``name``) when a module of ``modules`` whose jitted functions they call changed.
 
-    Numba keys a cached function on its own file only (numba issue #1833): the kernel calls
-    ``worn_bore_clearance`` (clearance.py), ``film_arguments``/``short_film``
-    (lubrication.py) and ``finite_film`` (reynolds.py), so an edit or an upgrade there would otherwise be served the old kernel.
-    A stamp of those files' bytes kept beside the cache decides; returns whether it flushed.
+    Numba keys a cached function on its own file only (numba issue #1833), so an edit or an
+    upgrade of a called module would otherwise be served the old machine code. A stamp of those
+    files' bytes kept beside the cache decides; returns whether it flushed.
     """
     import hashlib
     from pathlib import Path
 
-    from ..laws import lubrication, reynolds
-    from ..model import clearance
-
     digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes()
-                                     for m in (clearance, lubrication, reynolds))).hexdigest()
-    cached = [f for f in globals().values()
+                                     for m in modules)).hexdigest()
+    cached = [f for f in namespace.values()
               if getattr(f, "_cache", None) is not None and hasattr(f, "py_func")]
     try:
-        stamp = Path(cached[0]._cache._cache_path) / f"{__name__.rsplit('.', 1)[-1]}.deps"
+        stamp = Path(cached[0]._cache._cache_path) / f"{name.rsplit('.', 1)[-1]}.deps"
     except (IndexError, AttributeError):  # no cached function, or numba's internals moved
         return False
     try:
@@ -921,6 +993,16 @@ def _flush_if_dependencies_changed() -> bool:
     except OSError:
         pass  # a read-only cache: compiled again next time, never stale
     return True
+
+
+def _flush_if_dependencies_changed() -> bool:
+    """Flush this module's Numba cache when a module whose jitted functions it calls changed:
+    ``worn_bore_clearance`` (clearance.py), ``film_arguments``/``short_film``
+    (lubrication.py), ``finite_film`` (reynolds.py) and ``speed_profile`` (joints.py)."""
+    from ..laws import lubrication, reynolds
+    from ..model import clearance, joints
+
+    return flush_if_changed(globals(), __name__, (clearance, lubrication, reynolds, joints))
 
 
 _flush_if_dependencies_changed()

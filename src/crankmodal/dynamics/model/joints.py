@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 
 @dataclass
@@ -98,30 +99,42 @@ class SpeedProfile:
     ramp_time: float = 0.0
     omega_start: float = 0.0
 
-    def _s(self, t):
-        return min(max(t / self.ramp_time, 0.0), 1.0)
-
     def angle(self, t: float) -> float:
-        if self.ramp_time <= 0.0:
-            return self.theta0 + self.omega * t
-        w0, dw, T = self.omega_start, self.omega - self.omega_start, self.ramp_time
-        if t >= T:
-            return self.theta0 + w0 * t + dw * (T / 2 + (t - T))
-        s = self._s(t)
-        return self.theta0 + w0 * t + dw * T * (s**3 - 0.5 * s**4)
+        """Crank angle at ``t`` s, rad."""
+        return speed_profile(float(t), *self.table())[0]
 
     def speed(self, t: float) -> float:
-        if self.ramp_time <= 0.0:
-            return self.omega
-        # contact.step in scalar arithmetic (the same operations, without NumPy's call costs)
-        s = self._s(t)
-        return self.omega_start + (self.omega - self.omega_start) * s * s * (3.0 - 2.0 * s)
+        """Crank speed at ``t`` s, rad/s."""
+        return speed_profile(float(t), *self.table())[1]
 
     def acceleration(self, t: float) -> float:
-        if self.ramp_time <= 0.0 or t >= self.ramp_time or t <= 0.0:
-            return 0.0
-        s = self._s(t)
-        return (self.omega - self.omega_start) * 6.0 * s * (1.0 - s) / self.ramp_time
+        """Crank angular acceleration at ``t`` s, rad/s^2."""
+        return speed_profile(float(t), *self.table())[2]
+
+    def table(self) -> tuple:
+        """``(omega, theta0, ramp_time, omega_start)`` as floats: the row of
+        :func:`speed_profile`'s arguments the compiled kernel keeps."""
+        return (float(self.omega), float(self.theta0), float(self.ramp_time),
+                float(self.omega_start))
+
+
+@njit(cache=True)
+def speed_profile(t, omega, theta0, ramp_time, omega_start):
+    """Angle (rad), speed (rad/s) and acceleration (rad/s^2) of a :class:`SpeedProfile` at
+    ``t`` s: constant ``omega``, or ``omega_start`` -> ``omega`` by an ADAMS STEP (cubic
+    smoothstep of ``t / ramp_time``) over ``ramp_time`` s. The one implementation: the Python
+    path's :class:`SpeedProfile` and the compiled kernel both call it."""
+    if ramp_time <= 0.0:
+        return theta0 + omega * t, omega, 0.0
+    w0, dw, T = omega_start, omega - omega_start, ramp_time
+    s = min(max(t / T, 0.0), 1.0)
+    if t >= T:
+        angle = theta0 + w0 * t + dw * (T / 2 + (t - T))
+    else:
+        angle = theta0 + w0 * t + dw * T * (s**3 - 0.5 * s**4)
+    speed = w0 + dw * s * s * (3.0 - 2.0 * s)
+    acc = 0.0 if (t >= T or t <= 0.0) else dw * 6.0 * s * (1.0 - s) / T
+    return angle, speed, acc
 
 
 @dataclass
@@ -143,3 +156,10 @@ class AngleDrive:
         nu = np.array([self.profile.speed(t)])
         gamma = np.array([-ba[2] + self.profile.acceleration(t)])
         return phi, [(self.a, Ja[2:3])], nu, gamma
+
+
+def frames_of(c):
+    """The (body, frame) pairs a pin, slider or drive constrains."""
+    if isinstance(c, Revolute):
+        return [(c.a, c.frame_a), (c.b, c.frame_b)]
+    return [(c.a, c.frame_a)]

@@ -17,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import NumericalError
-from . import fastpath
 from .bodies import Ground, RigidBody
 from .joints import AngleDrive
 
@@ -82,9 +81,6 @@ class Multibody:
             self._kkt[: self.n, : self.n] = self.mass_matrix(np.zeros(self.n))
         self.nfev = 0
         self.max_nfev = None
-        self._cache = None
-        self._register_frames()
-        self._table = fastpath.RigidConstraintTable(self) if fastpath.applicable(self) else None
         self._drive_rows = np.zeros(self.m, bool)
         for c, r in zip(self.constraints, self.rows):
             self._drive_rows[r] = isinstance(c, AngleDrive)
@@ -120,50 +116,9 @@ class Multibody:
         """Pose, Jacobian (3, ndof_body) and ``Jdot qdot`` of an interface frame."""
         if isinstance(body, Ground):
             return body.frame_pose(None, frame), _NO_JACOBIAN, np.zeros(3)
-        cache = self._cache
-        if cache is not None and cache[0] is q:
-            k = self._frame_index.get((id(body), frame))
-            if k is not None:
-                return cache[1][k], cache[2][k], cache[3][k]
         s = self.slices[id(body)]
         return (body.frame_pose(q[s], frame), body.frame_jacobian(q[s], frame),
                 body.frame_bias(q[s], qd[s], frame))
-
-    def _register_frames(self):
-        """Index the rigid-body frames used by joints and loads for vectorised evaluation."""
-        self._frame_index = {}
-        ib, loc = [], []
-        for b in self.bodies:
-            if not isinstance(b, RigidBody):
-                continue
-            for name in b.frames:
-                s, phi = b.local(name)
-                self._frame_index[(id(b), name)] = len(ib)
-                ib.append(self.slices[id(b)].start)
-                loc.append((s[0], s[1], phi))
-        self._fi = np.array(ib, int)
-        self._floc = np.array(loc, float).reshape(-1, 3)
-
-    def _fill_cache(self, q, qd):
-        self._cache = self._frame_table(q, qd)
-        return self._cache
-
-    def _frame_table(self, q, qd):
-        """Poses, Jacobians, ``Jdot qdot`` and rotated offsets of all rigid frames (pure)."""
-        i, L = self._fi, self._floc
-        th = q[i + 2]
-        c, sn = np.cos(th), np.sin(th)
-        ax = c * L[:, 0] - sn * L[:, 1]
-        ay = sn * L[:, 0] + c * L[:, 1]
-        k = len(i)
-        pose = np.column_stack([q[i] + ax, q[i + 1] + ay, th + L[:, 2]])
-        J = np.zeros((k, 3, 3))
-        J[:, 0, 0] = J[:, 1, 1] = J[:, 2, 2] = 1.0
-        J[:, 0, 2] = -ay
-        J[:, 1, 2] = ax
-        w2 = qd[i + 2] ** 2
-        bias = np.column_stack([-w2 * ax, -w2 * ay, np.zeros(k)])
-        return (q, pose, J, bias, np.column_stack([ax, ay]))
 
     def frame_pose_only(self, body, frame, q):
         if isinstance(body, Ground):
@@ -190,16 +145,8 @@ class Multibody:
         return M
 
     def constraint_terms(self, t, q, qd):
-        """``Phi``, ``Phi_q`` (m, n), ``nu = -Phi_t`` and ``gamma``."""
-        if self._table is not None:
-            c = self._cache
-            if c is None or c[0] is not q:
-                c = self._frame_table(q, qd)
-            return self._table.terms(t, c[1], c[4], c[3])
-        return self.generic_constraint_terms(t, q, qd)
-
-    def generic_constraint_terms(self, t, q, qd):
-        """Constraint terms joint by joint (any body type)."""
+        """``Phi``, ``Phi_q`` (m, n), ``nu = -Phi_t`` and ``gamma``, joint by joint (any body
+        type)."""
         phi = np.empty(self.m)
         Cq = np.zeros((self.m, self.n))
         nu = np.empty(self.m)
@@ -239,7 +186,6 @@ class Multibody:
         if k is not None:
             return k.solve(t, q, qd, v_impact)
         n = self.n
-        self._fill_cache(q, qd)
         Q = np.zeros(n)
         for b in self.bodies:
             s = self.slices[id(b)]
@@ -260,7 +206,6 @@ class Multibody:
         K[:n, n:] = Cq.T
         K[n:, :n] = Cq
         sol = np.linalg.solve(K, rhs)
-        self._cache = None
         qdd, lam = sol[:n], sol[n:]
         return {"qdd": qdd, "lam": lam, "phi": phi, "Cq": Cq, "nu": nu, "contacts": contacts,
                 "p_loads": p_loads}
