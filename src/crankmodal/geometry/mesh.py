@@ -288,6 +288,40 @@ def check_size_floor(params, settings: MeshSettings) -> float:
     return n
 
 
+def fe_mesh_settings(size: float, order: int = 2, refine: float = 0.4, optimize: bool = True,
+                     fe_follows: bool = True) -> MeshSettings:
+    """:class:`MeshSettings` whose element limit is :data:`MAX_ELEMENTS`, or fewer when an FE
+    solve follows (``fe_follows``) and the memory available could not hold its factorisation.
+
+    Parameters
+    ----------
+    size : float
+        Target element size, m.
+    order : int
+        1 or 2.
+    refine : float
+        Size on detail faces as a fraction of ``size``.
+    optimize : bool
+        Optimise the tetrahedra after meshing.
+    fe_follows : bool
+        A stiffness matrix of this mesh will be factorised (modal, static, reduction).
+    """
+    limit, reason = MAX_ELEMENTS, "crankmodal's limit on the mesh size"
+    if fe_follows:
+        from ..fem.memory import available_bytes
+
+        avail = available_bytes()
+        fe = fe_element_limit(order, avail) if order in (1, 2) else None
+        # 1.5x: the count estimate is within -35 % / +19 %, and the FE stage's own memory
+        # check, on the real DOF count, decides the close cases
+        if fe is not None and 1.5 * fe < limit:
+            limit = 1.5 * fe
+            reason = (f"1.5x the P{order} elements whose FE factorisation, "
+                      f"0.42 GB x (DOF / 85k)^1.5, fits in the {avail / 1e9:.3g} GB available")
+    return MeshSettings(size=size, order=order, refine=refine, optimize=optimize,
+                        max_elements=limit, limit_reason=reason)
+
+
 def fe_element_limit(order: int, available_bytes: float | None) -> float | None:
     """Largest element count whose FE factorisation fits in ``available_bytes``, or None.
 

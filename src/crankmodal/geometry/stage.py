@@ -42,22 +42,10 @@ def mesh_settings(p: dict):
     """The :class:`~crankmodal.geometry.mesh.MeshSettings` of validated parameters ``p``: the
     element limit is :data:`~crankmodal.geometry.mesh.MAX_ELEMENTS`, or fewer when an FE stage
     follows and the memory available could not hold its factorisation."""
-    from .mesh import MAX_ELEMENTS, MeshSettings, fe_element_limit
+    from .mesh import fe_mesh_settings
 
-    limit, reason = MAX_ELEMENTS, "crankmodal's limit on the mesh size"
-    if p.get("fe_follows"):
-        from ..fem.memory import available_bytes
-
-        avail = available_bytes()
-        fe = fe_element_limit(p["element_order"], avail)
-        # 1.5x: the count estimate is within -35 % / +19 %, and the FE stage's own memory
-        # check, on the real DOF count, decides the close cases
-        if fe is not None and 1.5 * fe < limit:
-            limit = 1.5 * fe
-            reason = (f"1.5x the P{p['element_order']} elements whose FE factorisation, "
-                      f"0.42 GB x (DOF / 85k)^1.5, fits in the {avail / 1e9:.3g} GB available")
-    return MeshSettings(size=p["mesh_size"], order=p["element_order"], refine=p["refine"],
-                        optimize=p["optimize"], max_elements=limit, limit_reason=reason)
+    return fe_mesh_settings(p["mesh_size"], p["element_order"], p["refine"], p["optimize"],
+                            bool(p.get("fe_follows")))
 
 
 def validate(raw: dict, scene) -> dict:

@@ -1,183 +1,56 @@
-"""Flexible crank and rods for a crank train: reduce the machine's parts (cached) and make bodies.
+"""Planar flexible bodies for crank trains and four-bars, made from reduced (flexbody) files.
 
-The chain of :mod:`crankmodal.geometry` → :mod:`crankmodal.fem` → :mod:`crankmodal.reduction`
-run for one part of a machine file, its Craig–Bampton body stored under
-``$CRANKMODAL_CACHE/flexbodies/<key>.npz`` (key: the part's cache key, the material, the
-interfaces, the reduction settings and the reduction package's source), then read as a planar
-:class:`~.flexible.FlexibleBody` with the frame names a crank train uses:
+The part → reduced body pipeline is :mod:`crankmodal.reduction.parts`; :func:`reduced_part`
+here is that pipeline with messages naming the ``[dynamics.flexible]`` table's keys. Bodies:
 
-- crank: ``main_<j>`` one per main journal (j from 1), ``pin_<i>`` the crankpin band carrying rod
-  ``i`` (the band whose axial position is nearest the rod's row), ``drive`` (the flywheel end face
-  if the part has one, else the first journal); body axes turned so that the frame angle is the
-  crank angle (pin along +x), with the two rigid tilts (a shaft held at two journals).
-- rod: ``big`` and ``small`` (the bores), body x axis from the big to the small end.
+- crank (:func:`crank_body`): any number of throws (:func:`crank_throws`: the crankpin bands
+  grouped by their pin axis and the main journals between them, in axial order from the free
+  end). Frames ``main_<j>`` one per main journal in axial order (j from 1), ``pin_<i>`` the
+  crankpin band carrying cylinder ``i`` (on its throw, the band nearest its rod row), ``drive``
+  (the flywheel end face if the part has one, else the first journal); body axes turned so that
+  the frame angle is the crank angle of throw 1 (its pin along +x), with the two rigid tilts (a
+  shaft held at two or more journals).
+- rod (:func:`rod_body`): ``big`` and ``small`` (the bores), body x axis from the big to the
+  small end.
 - four-bar link (:func:`link_body`): its two joints (crank ``A``/``B``, coupler ``B``/``C``,
   rocker ``D``/``C``), body x axis from the first to the second; from a file, or a prismatic
-  bar between two pins reduced here (:func:`reduced_bar`).
+  bar between two pins (:func:`~crankmodal.reduction.parts.reduced_bar`).
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 from pathlib import Path
 
 import numpy as np
 
-from ...errors import ParameterError, SceneError, scene_keys
+from ...errors import ParameterError
+from ...reduction import parts
+from ...reduction.parts import (cached_flexbody, check_bar, crank_interface_specs,  # noqa: F401
+                                flexbody_cache_dir, reduced_bar)
 
 #: relative tolerance on the crank radius and rod length a reduced body must match
 GEOMETRY_TOLERANCE = 0.01
+#: tolerance on a throw's phase against the one the caller expects, degrees
+PHASE_TOLERANCE_DEG = 1.0
 
 
-def flexbody_cache_dir() -> Path:
-    """``$CRANKMODAL_CACHE/flexbodies`` (default ``~/.cache/crankmodal/flexbodies``)."""
-    from ...caches import cache_folder
-
-    return cache_folder("flexbodies")
+def flexible_table(part: str) -> str:
+    """The ``[dynamics.flexible]`` table that reduces a machine's ``part`` (messages)."""
+    return f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
 
 
-def cached_flexbody(path: Path, where: str) -> bool:
-    """Whether ``path`` holds a sound cached flexbody. A damaged one (truncated, bit-flipped,
-    emptied: :func:`~crankmodal.reduction.io.load_flexbody` refuses it) is removed with a
-    one-line warning naming it and what is wrong, so that the caller rebuilds it, as
-    :mod:`crankmodal.geometry.cache` does for parts."""
-    from ...caches import discard_damaged
-    from ...errors import InputFileError
-    from ...reduction.io import load_flexbody
-
-    if not path.is_file():
-        return False
-    try:
-        load_flexbody(path)
-        return True
-    except InputFileError as exc:
-        why = getattr(exc, "member", "")
-        why = f"{why}: {exc.text}" if why else getattr(exc, "text", str(exc))
-        discard_damaged(path, f"{where}: the cached flexbody", why)
-        return False
-
-
-def _reduction_source_digest() -> str:
-    h = hashlib.sha256()
-    for folder in ("reduction", "fem"):
-        for path in sorted((Path(__file__).parents[2] / folder).glob("*.py")):
-            h.update(path.read_bytes())
-    return h.hexdigest()
-
-
-def crank_interface_specs(regions, rods_per_pin: int) -> list[dict]:
-    """Distributing interfaces of a crankshaft part: each main journal, each crankpin region cut
-    into ``rods_per_pin`` bands, and the flywheel end face if present."""
-    mains = sorted(n for n in regions if n.startswith("main_journal"))
-    pins = sorted(n for n in regions if n.startswith("crankpin"))
-    if len(mains) < 1 or not pins:
-        raise SceneError("dynamics.flexible.crank: the part has no main_journal_* or crankpin_* "
-                         f"regions (regions: {', '.join(sorted(regions))})")
-    specs = [{"region": n, "kind": "distributing", "segments": 1} for n in mains]
-    specs += [{"region": n, "kind": "distributing", "segments": rods_per_pin} for n in pins]
-    if "flywheel_end_face" in regions:
-        specs.append({"region": "flywheel_end_face", "kind": "distributing", "segments": 1})
-    return specs
-
-
-def check_part(machine: str, part: str, spec: dict) -> tuple[dict, dict]:
-    """The validated ``[geometry]`` and ``[material]`` parameters of the part
-    :func:`reduced_part` makes, checked before anything is built (the part's lengths, the
-    element count of ``mesh_size``, the material); a ``crankmodal check`` refuses what a run
-    would. Errors name the ``[dynamics.flexible]`` table's keys
-    (``dynamics.flexible.crank.mesh_size``).
-
-    Raises
-    ------
-    SceneError
-    """
-    from types import SimpleNamespace
-
-    from ...fem.material_stage import validate as validate_material
-    from ...geometry.stage import validate as validate_geometry
-
-    where = f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
-    raw = {"machine": machine, "part": part, "fidelity": spec["fidelity"],
-           "mesh_size": spec["mesh_size"], "element_order": spec["element_order"]}
-    try:
-        gp = validate_geometry(raw, SimpleNamespace(sections={"reduction": {}}))
-        mp = validate_material({"name": spec["material"]}, None)
-    except SceneError as exc:
-        text = str(exc)
-        for key in ("mesh_size", "element_order", "fidelity"):  # this table's own keys
-            text = text.replace(f"geometry.{key}", f"{where}.{key}")
-        raise SceneError(text if text.startswith(where) else f"{where}: {text}") from None
-    return gp, mp
+def check_part(machine: str, part: str, spec: dict):
+    """:func:`crankmodal.reduction.parts.check_part` with errors naming the
+    ``[dynamics.flexible]`` table's keys (``dynamics.flexible.crank.mesh_size``)."""
+    return parts.check_part(machine, part, spec, key=flexible_table(part))
 
 
 def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1) -> Path:
-    """The ``crankmodal-flexbody`` file of a machine's part, reduced once and cached.
-
-    Parameters
-    ----------
-    machine : str
-        Machine file name (``geometry/<machine>.toml``).
-    part : {"crankshaft", "rod"}
-    spec : dict
-        Validated ``[dynamics.flexible.<body>]`` keys: ``fidelity``, ``mesh_size`` (m),
-        ``element_order``, ``material``, ``fixed_interface_modes``.
-    n_rods : int
-        Rods on the crank (crankshaft only): each crankpin region is cut into
-        ``ceil(n_rods / crankpin regions)`` bands, one interface each.
-    """
-    from ...fem.assembly import assemble
-    from ...fem.material_stage import make_material
-    from ...geometry.cache import part_key
-    from ...geometry.stage import make_part
-    from ...reduction.interfaces import make_interfaces
-    from ...reduction.io import save_flexbody
-    from ...reduction.reduce import reduce_body
-    from ...reduction.stage import interface_specs
-
-    where = f"dynamics.flexible.{'crank' if part == 'crankshaft' else 'rods'}"
-    gp, mp = check_part(machine, part, spec)
-    desc = {"part": part, "params": gp["part_params"].to_dict(), "fidelity": gp["fidelity"],
-            "mesh": {"size": spec["mesh_size"], "order": spec["element_order"]}}
-    key_text = json.dumps({"part": part_key(desc), "material": spec["material"],
-                           "modes": spec["fixed_interface_modes"], "n_rods": n_rods,
-                           "source": _reduction_source_digest(), "format": 1}, sort_keys=True)
-    key = hashlib.sha256(key_text.encode()).hexdigest()[:32]
-    path = flexbody_cache_dir() / f"{machine}_{part}_{key}.npz"
-    if cached_flexbody(path, where):
-        return path
-    import time
-
-    from ...progress import PhaseTimings
-
-    steps = PhaseTimings(f"{where}: reducing the {part}", 4)
-    t0 = time.perf_counter()
-    prt, _ = make_part(gp)
-    steps["part_s"] = time.perf_counter() - t0
-    mat = make_material(mp)
-    t0 = time.perf_counter()
-    model = assemble(prt, mat)
-    steps["assembly_s"] = time.perf_counter() - t0
-    if part == "crankshaft":
-        n_pins = sum(1 for n in prt.regions if n.startswith("crankpin"))
-        specs = crank_interface_specs(prt.regions, -(-n_rods // max(n_pins, 1)))
-    else:
-        specs = [{"region": n, "kind": "distributing", "segments": 1}
-                 for n in ("big_end_bore", "small_end_bore")]
-    with scene_keys(where, {"n_modes": "fixed_interface_modes"}):
-        itf = make_interfaces(prt, interface_specs(prt, {"interfaces": specs,
-                                                         "coupling": "distributing"}))
-        t0 = time.perf_counter()
-        body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"], mesh=prt.mesh,
-                              name=prt.name, info={"part": prt.name, "material": mat.name,
-                                                   "machine": machine})
-    steps["reduction_s"] = time.perf_counter() - t0
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_flexbody(path, body)  # atomic
-    steps["write_s"] = 0.0
-    steps.close()
-    return path
+    """:func:`crankmodal.reduction.parts.reduced_part` with errors naming the
+    ``[dynamics.flexible]`` table's keys: the flexbody file of a machine's crankshaft or rod,
+    reduced once and cached."""
+    return parts.reduced_part(machine, part, spec, n_rods=n_rods, key=flexible_table(part))
 
 
 def _in_plane_angle(v) -> float:
@@ -244,9 +117,141 @@ def _rows(row_z) -> list[float]:
     return arg.numbers("row_z", [0.0] if row_z is None else row_z)
 
 
+def _throw_groups(centres: dict, mains: list, bands: list) -> list[dict]:
+    """Crankpin bands grouped into throws: bands between the same two main journals whose pin
+    axes coincide (within 1e-3 of the crank radius) are one throw; throws in axial order."""
+    axis0 = np.mean([centres[n][:2] for n in mains], axis=0)
+    z_mains = np.sort([centres[n][2] for n in mains])
+    groups: list[dict] = []
+    for n in sorted(bands, key=lambda b: centres[b][2]):
+        arm = centres[n][:2] - axis0
+        bay = int(np.searchsorted(z_mains, centres[n][2]))
+        tol = 1e-3 * float(np.hypot(*arm)) + 1e-9
+        for g in groups:
+            if g["bay"] == bay and float(np.hypot(*(g["arm"] - arm))) <= tol:
+                g["bands"].append(n)
+                break
+        else:
+            groups.append({"bay": bay, "arm": arm, "bands": [n]})
+    for g in groups:
+        g["z"] = float(np.mean([centres[b][2] for b in g["bands"]]))
+    return sorted(groups, key=lambda g: g["z"])
+
+
+def crank_throws(source) -> list[dict]:
+    """The throws of a reduced crankshaft, from its interfaces.
+
+    Parameters
+    ----------
+    source : str, Path or reduced body
+        A ``crankmodal-flexbody`` file of a crankshaft (interfaces ``main_journal_*``,
+        ``crankpin_*`` bands), or that body read already.
+
+    Returns
+    -------
+    list of dict
+        Per throw, in axial order from the free end (throw 1 first): ``throw`` (1-based),
+        ``phase_deg`` (its pin's angle from throw 1's, about +z, in [0, 360)),
+        ``angle_deg`` (from the part's +x axis), ``radius_m`` (shaft axis to pin axis),
+        ``z_m`` (axial position of the middle of its crankpin bands, part coordinates, m),
+        ``bands`` (its crankpin interfaces in axial order) and ``bands_z_m``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``source``: not a flexbody, or no ``main_journal_*``/``crankpin_*`` interfaces.
+    """
+    fb, path = read(_source(source))
+    return _throws(_centres(fb), path)[1]
+
+
+def _throws(centres: dict, path) -> tuple[list, list]:
+    mains = sorted((n for n in centres if n.startswith("main_journal")),
+                   key=lambda n: centres[n][2])
+    bands = [n for n in centres if n.startswith("crankpin")]
+    if not mains or not bands:
+        raise ParameterError("source", f"{path}: needs main_journal_* and crankpin_* "
+                             f"interfaces; has {', '.join(sorted(centres)) or 'none'}")
+    groups = _throw_groups(centres, mains, bands)
+    a1 = _in_plane_angle(groups[0]["arm"])
+    out = []
+    for k, g in enumerate(groups, start=1):
+        a = _in_plane_angle(g["arm"])
+        out.append({"throw": k, "phase_deg": float(np.rad2deg(a - a1) % 360.0),
+                    "angle_deg": float(np.rad2deg(a) % 360.0),
+                    "radius_m": float(np.hypot(*g["arm"])), "z_m": g["z"],
+                    "bands": list(g["bands"]),
+                    "bands_z_m": [float(centres[b][2]) for b in g["bands"]]})
+    return mains, out
+
+
+def _cylinder_throws(throws, n_rows, n_throws: int) -> list[int]:
+    """Throw of each cylinder: given, or one cylinder per throw, or all on a single throw."""
+    from ... import arguments as arg
+
+    if throws is None:
+        if n_throws == 1:
+            return [1] * (n_rows or 1)
+        if n_rows in (None, n_throws):
+            return list(range(1, n_throws + 1))
+        raise ParameterError("throws", f"the crank has {n_throws} throws and row_z gives "
+                             f"{n_rows} cylinders: say which throw carries each cylinder "
+                             "(throws = [1-based throw per cylinder])")
+    if isinstance(throws, (str, bytes)) or not hasattr(throws, "__len__") or not len(throws):
+        raise ParameterError("throws", f"must be a list of throw numbers (1 to {n_throws}), one "
+                             f"per cylinder, got {throws!r:.60}")
+    out = []
+    for i, t in enumerate(throws):
+        t = arg.integer(f"throws[{i}]", t)
+        if not 1 <= t <= n_throws:
+            raise ParameterError(f"throws[{i}]", f"cylinder {i + 1} is on throw {t}; the crank "
+                                 f"has {n_throws} throw{'s' if n_throws > 1 else ''} "
+                                 f"(1 to {n_throws})")
+        out.append(t)
+    return out
+
+
+def _check_layout(info: list, mains: list, path, crank_radius, phases_deg, n_journals) -> None:
+    """The file's throws and journals against what the caller expects."""
+    from ... import arguments as arg
+
+    for t in info:
+        r = t["radius_m"]
+        if crank_radius is not None and abs(r / crank_radius - 1) > GEOMETRY_TOLERANCE:
+            raise ParameterError("source", f"{path}: its throw {t['throw']} pin is {r:.5g} m "
+                                 f"from the main journals' axis, the mechanism's crank radius "
+                                 f"is {crank_radius:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
+    if n_journals is not None:
+        n = arg.integer("n_journals", n_journals, ge=1)
+        if n != len(mains):
+            raise ParameterError("n_journals", f"{path}: the crank has {len(mains)} main "
+                                 f"journals, expected {n}")
+    if phases_deg is not None:
+        ph = arg.numbers("phases_deg", phases_deg)
+        have = [t["phase_deg"] for t in info]
+        if len(ph) != len(info):
+            raise ParameterError("phases_deg", f"{path}: the crank has {len(info)} throws at "
+                                 f"{_degrees(have)} deg, expected {len(ph)}")
+        for k, p in enumerate(ph):
+            want = (p - ph[0]) % 360.0
+            off = abs((have[k] - want + 180.0) % 360.0 - 180.0)
+            if off > PHASE_TOLERANCE_DEG:
+                raise ParameterError(f"phases_deg[{k}]", f"{path}: throw {k + 1} is at "
+                                     f"{have[k]:.4g} deg from throw 1, expected {want:.4g} "
+                                     f"(throws at {_degrees(have)} deg; tolerance "
+                                     f"{PHASE_TOLERANCE_DEG:g} deg)")
+
+
+def _degrees(values) -> str:
+    return ", ".join(f"{v:.4g}" for v in values)
+
+
 def crank_body(source, spec: dict | None = None, row_z=None, crank_radius: float | None = None,
-               name: str = "crank"):
+               name: str = "crank", throws=None, phases_deg=None, n_journals: int | None = None):
     """A planar flexible crank from a flexbody file, frames named for a crank train.
+
+    A crank with K throws at their phases and axial positions (:func:`crank_throws`) on N main
+    journals: every cylinder's rod sits on a crankpin band of its throw, nearest its row.
 
     Parameters
     ----------
@@ -258,53 +263,65 @@ def crank_body(source, spec: dict | None = None, row_z=None, crank_radius: float
         ``damping_ratio`` (default 0.02), as the ``[dynamics.flexible.crank]`` keys
         (:func:`body_spec`).
     row_z : sequence of float, optional
-        Axial position of each rod's row relative to the crankpin's middle, m (default
-        ``[0.0]``: one rod in the middle).
+        Per cylinder, the axial position of its rod row relative to the middle of its throw's
+        crankpin, m (default: 0 for each cylinder).
     crank_radius : float or None
-        The mechanism's crank radius, m, checked against the file (±1 %).
+        The mechanism's crank radius, m, checked against every throw of the file (±1 %).
+    name : str
+        The body's name.
+    throws : sequence of int, optional
+        Per cylinder, the 1-based throw carrying it (axial order from the free end). Default:
+        all cylinders on the one throw of a single-throw crank, or one cylinder per throw in
+        order when ``row_z`` is not given or has one entry per throw.
+    phases_deg : sequence of float, optional
+        The throws' phases the caller expects (degrees; only differences count), checked
+        against the file's (±1°).
+    n_journals : int, optional
+        The number of main journals the caller expects, checked against the file.
 
     Returns
     -------
     body : FlexibleBody
+        Frames ``main_1``..``main_N`` (journals in axial order), ``pin_1``..``pin_n`` (one per
+        cylinder), ``drive`` and ``main`` (= ``main_1``); ``info["roles"]`` maps each role to
+        its interface, ``info["throws"]`` is :func:`crank_throws`' list and
+        ``info["cylinder_throws"]`` the throw of each cylinder.
     roles : dict
-        ``mains`` (frame names), ``pins`` (one per rod), ``drive``; the default of
-        :func:`~.mechanisms.crank_train`'s ``crank_roles``.
+        ``mains`` (frame names), ``pins`` (one per cylinder), ``drive``: the default of
+        :func:`~crankmodal.dynamics.model.mechanisms.crank_train`'s ``crank_roles``.
 
     Raises
     ------
     ParameterError
-        Naming ``spec.<key>``, ``row_z``, ``crank_radius`` or ``source`` (interfaces missing,
-        or the crank radius off).
+        Naming ``spec.<key>``, ``row_z``, ``crank_radius``, ``throws`` (``throws[i]``: a
+        cylinder on a throw the crank does not have), ``phases_deg``, ``n_journals`` or
+        ``source`` (interfaces missing, a throw's radius off).
     """
     from ... import arguments as arg
     from .body import planar_body
 
     spec = body_spec(spec)
-    row_z = _rows(row_z)
+    rows = None if row_z is None else _rows(row_z)
     crank_radius = arg.number("crank_radius", crank_radius, gt=0.0, optional=True)
     fb, path = read(_source(source))
     centres = _centres(fb)
-    mains = sorted(n for n in centres if n.startswith("main_journal"))
-    bands = sorted(n for n in centres if n.startswith("crankpin"))
-    if not mains or not bands:
-        raise ParameterError("source", f"{path}: needs main_journal_* and crankpin_* "
-                             f"interfaces; has {', '.join(sorted(centres)) or 'none'}")
-    axis0 = np.mean([centres[n] for n in mains], axis=0)
-    pin_mid = np.mean([centres[n] for n in bands], axis=0)
-    arm = pin_mid[:2] - axis0[:2]
-    r_file = float(np.hypot(*arm))
-    if crank_radius is not None and abs(r_file / crank_radius - 1) > GEOMETRY_TOLERANCE:
-        raise ParameterError("source", f"{path}: its crankpin is {r_file:.5g} m from the main "
-                             f"journals' axis, the mechanism's crank radius is "
-                             f"{crank_radius:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
+    mains, info = _throws(centres, path)
+    _check_layout(info, mains, path, crank_radius, phases_deg, n_journals)
+    cyl = _cylinder_throws(throws, None if rows is None else len(rows), len(info))
+    rows = [0.0] * len(cyl) if rows is None else rows
+    if len(rows) != len(cyl):
+        raise ParameterError("row_z", f"gives {len(rows)} rows for {len(cyl)} cylinders "
+                             "(throws); give one per cylinder")
     pins = []
-    for z in row_z:
-        dz = [abs(centres[n][2] - pin_mid[2] - z) for n in bands]
-        pins.append(bands[int(np.argmin(dz))])
+    for t, z in zip(cyl, rows):
+        th = info[t - 1]
+        dz = [abs(zb - th["z_m"] - z) for zb in th["bands_z_m"]]
+        pins.append(th["bands"][int(np.argmin(dz))])
     drive = "flywheel_end_face" if "flywheel_end_face" in centres else mains[0]
+    arm1 = np.deg2rad(info[0]["angle_deg"])
     body = planar_body(fb, name, n_modes=spec.get("n_modes"), cutoff_hz=spec.get("cutoff_hz"),
                        damping_ratio=spec["damping_ratio"], tilt=len(mains) > 1,
-                       orientation=_in_plane_angle(arm), path=path)
+                       orientation=float(arm1), path=path)
     roles = {"mains": [], "pins": [], "drive": "drive"}
     for j, n in enumerate(mains, start=1):
         body.alias(f"main_{j}", n)
@@ -315,6 +332,9 @@ def crank_body(source, spec: dict | None = None, row_z=None, crank_radius: float
     body.alias("drive", drive)
     body.alias("main", mains[0])
     body.info["roles"] = {"mains": mains, "pins": pins, "drive": drive}
+    body.info["throws"] = info
+    body.info["cylinder_throws"] = cyl
+    body.info["mains_z_m"] = [float(centres[n][2]) for n in mains]
     return body, roles
 
 
@@ -368,121 +388,6 @@ def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
     body.alias("big", "big_end_bore")
     body.alias("small", "small_end_bore")
     return body
-
-
-def _bar_arguments(length, section, spec) -> None:
-    """The Python API's arguments of :func:`reduced_bar` (a scene's are validated already):
-    a ParameterError naming ``length``, ``section`` or ``spec.<key>``."""
-    from ...geometry.mesh import is_length
-
-    if not is_length(length):
-        raise ParameterError("length", f"must be a number > 0 m, got {length!r}")
-    if (not isinstance(section, (tuple, list)) or len(section) != 2
-            or not all(is_length(v) for v in section)):
-        raise ParameterError("section", f"must be [width, thickness], two numbers > 0 m, got "
-                             f"{section!r}")
-    if not isinstance(spec, dict):
-        raise ParameterError("spec", f"must be a dict, got {type(spec).__name__}")
-    checks = {"mesh_size": (is_length, "a number > 0 m"),
-              "element_order": (lambda v: v in (1, 2) and not isinstance(v, bool), "1 or 2"),
-              "material": (lambda v: isinstance(v, str), "a material name"),
-              "fixed_interface_modes": (lambda v: isinstance(v, int) and not isinstance(v, bool)
-                                        and 0 <= v <= 400, "an integer in [0, 400]")}
-    for k, (ok, rule) in checks.items():
-        if k not in spec or not ok(spec[k]):
-            raise ParameterError(f"spec.{k}", f"must be {rule}, got {spec.get(k, 'nothing')!r}")
-
-
-def check_bar(length: float, section, spec: dict, key: str) -> tuple:
-    """Refuse the bar of :func:`reduced_bar` before anything is built; return its divisions.
-
-    Its sides (``length``, ``section``) must be sizes crankmodal builds
-    (:data:`~crankmodal.geometry.checks.MIN_LENGTH` to ``MAX_LENGTH``), and its tetrahedra at
-    ``spec["mesh_size"]`` no more than the limit of parts meshed by gmsh
-    (:data:`~crankmodal.geometry.mesh.MAX_ELEMENTS`, or fewer when the memory available could not
-    hold the reduction's factorisation: :func:`~crankmodal.geometry.mesh.fe_element_limit`).
-
-    Raises
-    ------
-    SceneError
-        A side out of range, naming ``<key>.bar`` (or ``dynamics.four_bar.lengths``).
-    ResourceError
-        Too many tetrahedra, naming ``<key>.mesh_size`` and the smallest size allowed.
-    """
-    from ...errors import ResourceError
-    from ...fem.memory import available_bytes
-    from ...fem.testparts import check_bar_size
-    from ...geometry.checks import MAX_LENGTH, MIN_LENGTH
-    from ...geometry.mesh import MAX_ELEMENTS, MeshSizeError, fe_element_limit
-
-    _bar_arguments(length, section, spec)
-    sizes = f"the sizes crankmodal builds, [{MIN_LENGTH:g}, {MAX_LENGTH:g}] m"
-    if not MIN_LENGTH <= length <= MAX_LENGTH:
-        raise SceneError(f"dynamics.four_bar.lengths: the {key.rsplit('.', 1)[-1]} bar reduced "
-                         f"here is {length:.6g} m long, outside {sizes}")
-    for v in section:
-        if not MIN_LENGTH <= v <= MAX_LENGTH:
-            raise SceneError(f"{key}.bar: every side must be in {sizes}, got {v:.6g}")
-    limit, reason = MAX_ELEMENTS, "crankmodal's limit on the mesh size"
-    avail = available_bytes()
-    fe = fe_element_limit(spec["element_order"], avail)
-    if fe is not None and fe < limit:
-        limit = fe
-        reason = (f"the P{spec['element_order']} elements whose FE factorisation, "
-                  f"0.42 GB x (DOF / 85k)^1.5, fits in the {avail / 1e9:.3g} GB available")
-    try:
-        return check_bar_size((length, *map(float, section)), spec["mesh_size"], limit, reason)
-    except MeshSizeError as exc:
-        raise ResourceError(exc.worded(f"{key}.mesh_size")) from None
-
-
-def reduced_bar(length: float, section, spec: dict, key: str) -> Path:
-    """The ``crankmodal-flexbody`` file of a prismatic steel (or ``spec["material"]``) bar
-    between two pins, reduced once and cached.
-
-    A link for a mechanism with no part of its own (the seed-001 loom's four-bar): a
-    structured tetrahedral bar (:func:`crankmodal.fem.testparts.bar`, no gmsh) along x of
-    ``length`` (m, the distance between the joints), in-plane width ``section[0]`` and
-    thickness ``section[1]`` (m), about ``spec["mesh_size"]`` (m) per element edge, reduced
-    (Craig–Bampton, ``spec["fixed_interface_modes"]``) on its two end faces ``end_x0`` and
-    ``end_x1`` with distributing (RBE3) couplings: each joint is the mean motion of an end face,
-    at the face centre. ``key`` names the scene table in messages.
-    """
-    from ...fem.assembly import assemble
-    from ...fem.material_stage import make_material
-    from ...fem.material_stage import validate as validate_material
-    from ...fem.testparts import bar
-    from ...reduction.interfaces import make_interfaces
-    from ...reduction.io import save_flexbody
-    from ...reduction.reduce import reduce_body
-
-    div = check_bar(length, section, spec, key)
-    width, thickness = (float(v) for v in section)
-    try:
-        mp = validate_material({"name": spec["material"]}, None)
-    except SceneError as exc:
-        raise SceneError(f"{key}.material: {exc}") from None
-    key_text = json.dumps({"bar": [length, width, thickness], "divisions": div,
-                           "order": spec["element_order"], "material": spec["material"],
-                           "modes": spec["fixed_interface_modes"],
-                           "source": _reduction_source_digest(), "format": 1}, sort_keys=True)
-    digest = hashlib.sha256(key_text.encode()).hexdigest()[:32]
-    path = flexbody_cache_dir() / f"bar_{digest}.npz"
-    if cached_flexbody(path, key):
-        return path
-    part = bar(length, width, thickness, div, order=spec["element_order"])
-    mat = make_material(mp)
-    model = assemble(part, mat)
-    with scene_keys(key, {"n_modes": "fixed_interface_modes"}):
-        itf = make_interfaces(part, [{"region": n, "kind": "distributing"}
-                                     for n in ("end_x0", "end_x1")])
-        body, _ = reduce_body(model, itf, n_modes=spec["fixed_interface_modes"],
-                              mesh=part.mesh, name="bar",
-                              info={"part": "bar", "material": mat.name, "length_m": length,
-                                    "section_m": [width, thickness]})
-    path.parent.mkdir(parents=True, exist_ok=True)
-    save_flexbody(path, body)  # atomic
-    return path
 
 
 def link_body(source, spec: dict | None = None, length: float | None = None,
@@ -573,5 +478,5 @@ def rigid_twin(body):
 
 
 __all__ = ["cached_flexbody", "check_bar", "check_part", "crank_body", "crank_interface_specs",
-           "flexbody_cache_dir", "link_body", "read",
+           "crank_throws", "flexbody_cache_dir", "flexible_table", "link_body", "read",
            "reduced_bar", "reduced_part", "rigid_twin", "rod_body"]
