@@ -113,6 +113,7 @@ _EXPORTS: dict[str, tuple[str, str]] = {
     "SolverSettings": ("crankmodal.dynamics.run.integrate", "SolverSettings"),
     "integrate": ("crankmodal.dynamics.run.integrate", "integrate"),
     "History": ("crankmodal.dynamics.results.history", "History"),
+    "DynamicsResult": ("crankmodal.dynamics.results.result", "DynamicsResult"),
     "simulate": ("crankmodal.dynamics.run.simulate", "simulate"),
     "quasi_static_start": ("crankmodal.dynamics.flexible.initial", "quasi_static_start"),
 }
@@ -129,6 +130,7 @@ __all__ = [
     "CriticalSpeeds",
     "Cylinder",
     "CylindricalSurface",
+    "DynamicsResult",
     "FEModel",
     "FlexibleBody",
     "FrictionLaw",

@@ -15,25 +15,27 @@ FOUR_BAR_JOINTS = {"A": "crank pivot", "B": "crank-coupler", "C": "coupler-rocke
                    "D": "rocker pivot"}
 
 
-def _force_series(hist, rigid, mech) -> list[tuple[str, np.ndarray, np.ndarray | None]]:
+def _force_series(hist, rigid, machine) -> list[tuple[str, np.ndarray, np.ndarray | None]]:
     """The forces drawn: (title, flexible, rigid twin or None), each an (n, 2) array in N.
 
     A four-bar: its joints A, B, C, D. A crank train: the main-bearing sum, then each main
     journal when there are several."""
-    if mech.kind == "four_bar":
+    if machine.kind == "four_bar":
         return [(f"joint {j} ({what}) of the four-bar", hist.joint_forces[j],
                  None if rigid is None else rigid.joint_forces[j])
                 for j, what in FOUR_BAR_JOINTS.items() if j in hist.joint_forces]
-    joints = mech.main_joints if len(mech.main_joints) > 1 else []
+    joints = machine.main_joints if len(machine.main_joints) > 1 else []
     series = [("main bearing (sum)", hist.main_bearing_force,
                None if rigid is None else rigid.main_bearing_force)]
     return series + [(f"journal {j}", hist.joint_forces[j],
                       None if rigid is None else rigid.joint_forces[j]) for j in joints]
 
 
-def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
+def plot_main_bearing(hist, rigid, machine, sel, path: Path) -> Path:
     """Joint forces over the last revolution (flexible solid, rigid twin dashed) and the order
-    amplitudes of the main-bearing force.
+    amplitudes of the main-bearing force; ``machine``: a
+    :class:`~crankmodal.dynamics.results.result.MachineInfo` (``kind``, ``main_joints``,
+    ``revolution_hz``), ``sel``: the results window's samples.
 
     A crank train: one panel for the main-bearing force magnitude (the sum) and one per main
     journal. A four-bar: one panel per joint A, B, C, D, each with the magnitude of the
@@ -41,8 +43,8 @@ def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
     from .signals import order_amplitudes
 
     plt = _plt()
-    four_bar = mech.kind == "four_bar"
-    series = _force_series(hist, rigid, mech)
+    four_bar = machine.kind == "four_bar"
+    series = _force_series(hist, rigid, machine)
     n = 1 + len(series)
     fig, ax = plt.subplots(n, 1, figsize=(9, 2.6 * n))
     last = last_revolutions(hist, 1.0) & sel
@@ -68,7 +70,7 @@ def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
             a.legend(loc="upper right", fontsize=8)
     orders = np.arange(13)
     t = hist.t[sel]
-    rev = mech.revolution_hz
+    rev = machine.revolution_hz
     if (t[-1] - t[0]) * rev >= 1.0 - 1e-9:
         af = order_amplitudes(t, hist.main_bearing_force[sel], rev, orders)
         w = 0.4
@@ -84,23 +86,17 @@ def plot_main_bearing(hist, rigid, mech, sel, path: Path) -> Path:
     return _save(plt, fig, path)
 
 
-def plot_modal(hist, mech, path: Path) -> Path:
-    """Modal coordinates of each flexible body against time (elastic modes only)."""
+def plot_modal(hist, machine, path: Path) -> Path:
+    """Modal coordinates of each flexible body against time (elastic modes only, the first
+    six); ``machine.flexible``: body name -> its elastic modes' frequencies, Hz."""
     plt = _plt()
-    bodies = [b for b in mech.system.bodies if getattr(b, "n_elastic", 0) > 0]
+    bodies = list(machine.flexible.items())
     fig, ax = plt.subplots(len(bodies), 1, figsize=(9, 2.4 * len(bodies)), squeeze=False)
-    for a, b in zip(ax[:, 0], bodies):
-        xi = hist.modal[b.name][:, :b.n_elastic]
-        for j in range(min(b.n_elastic, 6)):
-            a.plot(hist.t, xi[:, j] * 1e3, lw=0.8, label=f"{b.frequencies_hz[j]:.0f} Hz")
-        a.set(xlabel="t [s]", ylabel="ξ [mm kg^½]", title=f"{b.name}: modal coordinates")
+    for a, (name, freqs) in zip(ax[:, 0], bodies):
+        xi = hist.modal[name][:, :len(freqs)]
+        for j in range(min(len(freqs), 6)):
+            a.plot(hist.t, xi[:, j] * 1e3, lw=0.8, label=f"{freqs[j]:.0f} Hz")
+        a.set(xlabel="t [s]", ylabel="ξ [mm kg^½]", title=f"{name}: modal coordinates")
         a.legend(fontsize=7, ncol=3, loc="upper right")
         a.grid(alpha=0.3)
     return _save(plt, fig, path)
-
-
-def flexible_figures(hist, rigid, mech, sel, out: Path) -> list[str]:
-    """Write the figures; return their file names."""
-    figs = [plot_main_bearing(hist, rigid, mech, sel, out / "dynamics_flexible_main_bearing.png"),
-            plot_modal(hist, mech, out / "dynamics_flexible_modes.png")]
-    return [f.name for f in figs]

@@ -1,12 +1,18 @@
 """Scene stage ``[dynamics]``: crank-linkage dynamics with clearance joints.
 
 Runs the mechanism with its clearance joints (and, by default, its ideal-joint twin as the
-reference), writes ``dynamics.npz`` with every time history, PNG figures, and returns the summary
-numbers: peaks, impact statistics, main-bearing force per order, drive torque and power, the
-energy balance and the seed-001 contact-loss indicator.
+reference), and returns the summary numbers: peaks, impact statistics, main-bearing force per
+order, drive torque and power, the energy balance and the seed-001 contact-loss indicator. The
+runs become a :class:`~crankmodal.dynamics.results.result.DynamicsResult`, which draws the PNG
+figures and saves ``dynamics.npz`` (every time history). :func:`run` reads as its steps:
+:func:`_model`, :func:`_runs`, :func:`_run_numbers`, :func:`_joint_results`,
+:func:`_statistics`, :func:`_flexible_results`, :func:`_tolerance_study`, :func:`_result`,
+figures, :func:`_summary_line`, save.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -138,29 +144,70 @@ def _start_up_warning(p, rev_hz) -> str:
             f"start-up transient; give end_time >= {need:.4g} s or a spectrum_start")
 
 
-def run(params: dict, ctx) -> dict:
-    from dataclasses import replace
+@dataclass
+class _Model:
+    """The built mechanism and what its runs share (stage-internal)."""
 
+    mech: object
+    bodies: dict | None  # the flexible bodies' builds (None: a rigid run)
+    settings: object  # SolverSettings, the contact time scales in
+    rev_hz: float  # Hz
+    dt: float  # output step, s
+    t_end: float  # s
+    warnings: list  # texts, in the order issued
+    start_info: dict | None  # the quasi-static start's numbers
+
+
+@dataclass
+class _Runs:
+    """The run with clearance and its twins (stage-internal)."""
+
+    hist: object  # History
+    ideal: object = None  # History of the ideal-joint twin
+    rigid: object = None  # History of the rigid twin of a flexible run
+
+
+def run(params: dict, ctx) -> dict:
+    """Run the ``[dynamics]`` section: build, integrate (with the ideal and rigid twins),
+    summarise, draw and save; returns the results.json entry (see :class:`DynamicsResult`)."""
     from ...errors import warn
-    from ...results import atomic_path
-    from ..results.signals import (
-        amplitude_spectrum,
-        contact_durations,
-        contact_loss_indicator,
-        force_direction,
-        impact_statistics,
-        order_amplitudes,
-    )
-    from ..results.stats import converged_summary, statistics
-    from ..results.validity import penetration_warning
-    from ..run import timescales
-    from ..run.simulate import key_outputs, simulate, tolerance_study
-    from .build import build_mechanism, solver_settings
 
     p = params
-    bodies = None
+    model = _model(p, ctx)
+    runs = _runs(model, p, ctx)
+    sel, n_rev, start_up = _window(runs.hist, p, model.rev_hz)
+    if start_up:
+        warn(_start_up_warning(p, model.rev_hz), into=model.warnings)
+    res = _run_numbers(model, runs.hist, sel, n_rev)
+    res["warnings"] = model.warnings
+    res["clearance_joints"] = _joint_results(model, runs, sel, p)
+    _statistics(res, model, runs, sel, p)
+    if model.bodies is not None:
+        res["flexible"] = _flexible_results(model, runs, sel, p, res["warnings"])
+    study = _tolerance_study(res, model, runs.hist, sel, p)
+    result = _result(model, runs, sel, n_rev, res)
+    res["arrays"] = "dynamics.npz"
+    if ctx.figures:
+        res["figures"], flexible = result.figures(ctx.out_dir)
+        if model.bodies is not None:
+            res["flexible"]["figures"] = flexible
+    res["summary"] = _summary_line(res, model, runs.hist, sel, n_rev, study, p)
+    result.save(ctx.out_dir / "dynamics.npz")
+    ctx.products[SECTION] = {"mechanism": model.mech, "history": runs.hist, "ideal": runs.ideal,
+                             "rigid": runs.rigid, "result": result}
+    return res
+
+
+def _model(p: dict, ctx) -> _Model:
+    """Build the mechanism (its flexible bodies first) and its solver settings; refuse what
+    cannot finish within the run budget, warn of truncated modes, set the start."""
+    from ...errors import scene_keys, warn
+    from ..run import timescales
+    from ..run.budget import check as check_budget
+    from .build import build_mechanism, solver_settings
     from .keys import flexible_keys
 
+    bodies = None
     if flexible_keys(p):
         from .flexstage import make_bodies
 
@@ -168,55 +215,60 @@ def run(params: dict, ctx) -> dict:
     mech = _build(build_mechanism, p, ctx.params.get("mechanism"), bodies)
     rev_hz = mech.revolution_hz
     settings = solver_settings(p, 60.0 * rev_hz, flexible=bodies is not None)
-    dt = p["output_step"] or 1.0 / (360.0 * rev_hz)
-    t_end = p["end_time"]
     # contact time scales before the run: refuse what cannot finish within the budget, warn,
     # and let a failed run's advice name the key that limits the step
-    scales = timescales.joint_time_scales(mech)
-    settings = replace(settings, time_scales=tuple(scales))
-    early_warnings = []
+    settings = replace(settings, time_scales=tuple(timescales.joint_time_scales(mech)))
+    model = _Model(mech, bodies, settings, rev_hz, p["output_step"] or 1.0 / (360.0 * rev_hz),
+                   p["end_time"], [], None)
     if bodies is not None:
         from .flexstage import truncation_warnings
 
         for text in truncation_warnings(p, bodies):
-            warn(text, into=early_warnings)
-    from ...errors import scene_keys
-    from ..run.budget import check as check_budget
-
+            warn(text, into=model.warnings)
     with scene_keys("dynamics"):  # refuse what cannot finish (contact.damping: ... -> dynamics.)
-        for text in check_budget(mech, t_end, settings)[1]:
-            warn(text, into=early_warnings)
-    start_info = None
+        for text in check_budget(mech, model.t_end, settings)[1]:
+            warn(text, into=model.warnings)
     mech.start = p["flexible"]["start"]  # simulate() leaves an "undeformed" start as built
     if bodies is not None and p["flexible"]["start"] == "quasi_static":
-        start_info = mech.start_quasi_static()  # on the ideal-joint twin, as simulate() does
+        model.start_info = mech.start_quasi_static()  # on the ideal-joint twin, as simulate() does
     elif bodies is not None and p["ramp_time"] == 0.0:
         text = _start_warning(mech, p, rev_hz)
         if text:
-            warn(text, into=early_warnings)
-    tol = p["energy_tolerance"]
-    hist = simulate(mech, t_end, dt, settings, energy_tolerance=tol)
-    ideal = None
+            warn(text, into=model.warnings)
+    return model
+
+
+def _runs(model: _Model, p: dict, ctx) -> _Runs:
+    """Integrate the run with clearance, its ideal-joint twin (``run_ideal``) and, with
+    flexible bodies, its rigid twin (``run_rigid``)."""
+    from ..run.simulate import simulate
+    from .build import build_mechanism, solver_settings
+
+    mech, t_end, dt, tol = model.mech, model.t_end, model.dt, p["energy_tolerance"]
+    runs = _Runs(simulate(mech, t_end, dt, model.settings, energy_tolerance=tol))
     if p["run_ideal"] and mech.system.clearances:
-        ideal = simulate(mech, t_end, dt, settings, ideal=True, energy_tolerance=tol)
-    rigid = None
-    if bodies is not None and p["run_rigid"]:
+        runs.ideal = simulate(mech, t_end, dt, model.settings, ideal=True, energy_tolerance=tol)
+    if model.bodies is not None and p["run_rigid"]:
         from .flexstage import rigid_twins
 
-        rigid_mech = _build(build_mechanism, p, ctx.params.get("mechanism"), rigid_twins(bodies),
-                            twin=True)
-        rigid_settings = replace(solver_settings(p, 60.0 * rev_hz), time_scales=tuple(scales))
-        rigid = simulate(rigid_mech, t_end, dt, rigid_settings, energy_tolerance=tol)
-    sel, n_rev, start_up = _window(hist, p, rev_hz)
-    if start_up:
-        warn(_start_up_warning(p, rev_hz), into=early_warnings)
-    orders = list(range(13))
-    res = {"mechanism": mech.kind, "speed_rpm": 60.0 * rev_hz, "revolution_hz": rev_hz,
-           "end_time_s": t_end, "output_step_s": dt, "rhs_evals": hist.nfev,
-           "integration_wall_time_s": hist.wall_time, "solver_method": settings.method}
-    f = hist.main_bearing_force
-    # peaks: in the results window (the start-up left out, as for every other number), the
-    # samples and each contact's deepest point (an event: samples miss short impacts)
+        rigid_mech = _build(build_mechanism, p, ctx.params.get("mechanism"),
+                            rigid_twins(model.bodies), twin=True)
+        settings = replace(solver_settings(p, 60.0 * model.rev_hz),
+                           time_scales=model.settings.time_scales)
+        runs.rigid = simulate(rigid_mech, t_end, dt, settings, energy_tolerance=tol)
+    return runs
+
+
+def _run_numbers(model: _Model, hist, sel, n_rev: int) -> dict:
+    """The run's settings and cost, and its peaks, orders, drive and energy over the results
+    window ``sel`` (the start-up left out). Peaks: the samples and each contact's deepest
+    point (an event: samples miss short impacts)."""
+    from ..results.signals import order_amplitudes
+
+    rev_hz, f = model.rev_hz, hist.main_bearing_force
+    res = {"mechanism": model.mech.kind, "speed_rpm": 60.0 * rev_hz, "revolution_hz": rev_hz,
+           "end_time_s": model.t_end, "output_step_s": model.dt, "rhs_evals": hist.nfev,
+           "integration_wall_time_s": hist.wall_time, "solver_method": model.settings.method}
     tw = (float(hist.t[sel][0]), float(hist.t[sel][-1]))
     res["peak_window_s"] = list(tw)
     res["main_bearing_force_peak_n"] = hist.peak("main_bearing_force",
@@ -224,9 +276,10 @@ def run(params: dict, ctx) -> dict:
     mm = hist.main_bearing_moment
     res["main_bearing_moment_peak_nm"] = float(np.max(np.hypot(mm[sel, 0], mm[sel, 1])))
     if n_rev >= 1:
-        amps = order_amplitudes(hist.t[sel], f[sel], rev_hz, orders)
+        orders = list(range(13))
         res["main_bearing_orders"] = orders
-        res["main_bearing_order_amplitude_n"] = amps.tolist()  # rows: order; columns: x, y
+        res["main_bearing_order_amplitude_n"] = order_amplitudes(  # rows: order; columns: x, y
+            hist.t[sel], f[sel], rev_hz, orders).tolist()
     res["piston_acceleration_peak"] = hist.peak("piston_acceleration",
                                                 hist.piston_acceleration[sel], None,
                                                 *tw).tolist()
@@ -238,9 +291,21 @@ def run(params: dict, ctx) -> dict:
     res["energy"] = {k: float(v[-1]) for k, v in hist.energy.items()}
     res["energy_balance_error"] = hist.energy_error()
     res["constraint_drift_max"] = float(hist.constraint_drift.max())
+    return res
+
+
+def _joint_results(model: _Model, runs: _Runs, sel, p: dict) -> dict:
+    """Per clearance joint: peaks, contact fraction, eccentricity, impacts, the ideal twin's
+    contact-loss indicator, the thinnest oil film; warns (into ``model.warnings``) of contacts
+    shorter than two output steps and of laws outside their validity."""
+    from ...errors import warn
+    from ..results.signals import contact_durations, contact_loss_indicator, impact_statistics
+    from ..results.validity import penetration_warning
+
+    hist, ideal = runs.hist, runs.ideal
+    tw = (float(hist.t[sel][0]), float(hist.t[sel][-1]))
     joints = {}
-    res["warnings"] = early_warnings
-    for cj in mech.system.clearances:
+    for cj in model.mech.system.clearances:
         d = hist.contact[cj.name]
         dur = contact_durations(hist.onsets[cj.name], hist.separations[cj.name])
         j = {"clearance_m": cj.clearance, "law": cj.law,
@@ -254,15 +319,15 @@ def run(params: dict, ctx) -> dict:
                                              / cj.clearance),
              "contact_duration_median_s": float(np.median(dur)) if dur.size else None}
         j.update(impact_statistics(hist.onsets[cj.name], v_min=cj.v_impact_min))
-        if dur.size and np.median(dur) < 2.0 * dt:
-            warn(short_contact_warning(cj, float(np.median(dur)), dt), into=res["warnings"])
+        if dur.size and np.median(dur) < 2.0 * model.dt:
+            warn(short_contact_warning(cj, float(np.median(dur)), model.dt), into=model.warnings)
         # validity over the whole run, the start-up included: a law outside it there is too
         text = penetration_warning(cj, hist.peak("penetration",
                                                  np.maximum(d["penetration"], 0.0), cj.name),
                                    hist.peak("fn", d["fn"], cj.name),
                                    p["contact"]["E"], p["contact"]["nu"])
         if text:
-            warn(text, into=res["warnings"])
+            warn(text, into=model.warnings)
         if ideal is not None:
             j["contact_loss"] = contact_loss_indicator(ideal.t[sel], ideal.joint_forces[cj.name][sel],
                                                        ideal.crank_angle[sel])
@@ -270,86 +335,98 @@ def run(params: dict, ctx) -> dict:
             j["min_film_thickness_m"] = max(cj.clearance * (1.0 - j["eccentricity_ratio_max"]),
                                             0.0)
         joints[cj.name] = j
-    res["clearance_joints"] = joints
-    # per-revolution statistics: what converges (a single trajectory's peak does not)
-    v_min = {cj.name: cj.v_impact_min for cj in mech.system.clearances}
-    res["statistics"] = statistics(hist, rev_hz, float(hist.t[sel][0]), v_min)
+    return joints
+
+
+def _statistics(res: dict, model: _Model, runs: _Runs, sel, p: dict) -> None:
+    """Per-revolution statistics (what converges: a single trajectory's peak does not), the
+    ensemble's spread, the headline numbers and the ideal twin's, into ``res``."""
+    from ..results.stats import statistics
+    from ..run.ensemble import headlines, run_ensemble
+
+    hist, rev_hz = runs.hist, model.rev_hz
+    t0 = float(hist.t[sel][0])
+    v_min = {cj.name: cj.v_impact_min for cj in model.mech.system.clearances}
+    res["statistics"] = statistics(hist, rev_hz, t0, v_min)
     if p["ensemble"] > 1:
-        from ..run.ensemble import run_ensemble
-
-        res["ensemble"] = run_ensemble(mech, res["statistics"], p["ensemble"], t_end, dt,
-                                       settings, rev_hz, float(hist.t[sel][0]), v_min,
-                                       energy_tolerance=tol)
-    from ..run.ensemble import headlines
-
+        res["ensemble"] = run_ensemble(model.mech, res["statistics"], p["ensemble"], model.t_end,
+                                       model.dt, model.settings, rev_hz, t0, v_min,
+                                       energy_tolerance=p["energy_tolerance"])
     res["headline"] = headlines(res["statistics"], res.get("ensemble"))
-    if ideal is not None:  # the same window as the run with clearance
-        fi = ideal.main_bearing_force[sel]
-        res["ideal"] = {"main_bearing_force_peak_n": float(np.max(np.hypot(fi[:, 0], fi[:, 1]))),
-                        "piston_acceleration_peak":
-                            np.max(np.abs(ideal.piston_acceleration[sel]), axis=0).tolist()
-                            if ideal.piston_acceleration.size else [],
-                        "drive_power_mean_w": float(np.mean(ideal.drive_power[sel]))}
-        ist = statistics(ideal, rev_hz, float(hist.t[sel][0]), v_min)
-        res["ideal"]["main_bearing_per_rev_peak_n"] = ist["main_bearing_force"]["per_rev_peak"]["mean"]
-        res["ideal"]["main_bearing_rms_n"] = ist["main_bearing_force"]["rms"]["mean"]
-        for key, h in res["headline"].items():
-            if key in res["ideal"]:
-                h["ideal"] = res["ideal"][key]
-    if bodies is not None:
-        from .flexstage import flexible_results
+    if runs.ideal is None:
+        return
+    ideal = runs.ideal  # over the same window as the run with clearance
+    fi = ideal.main_bearing_force[sel]
+    res["ideal"] = {"main_bearing_force_peak_n": float(np.max(np.hypot(fi[:, 0], fi[:, 1]))),
+                    "piston_acceleration_peak":
+                        np.max(np.abs(ideal.piston_acceleration[sel]), axis=0).tolist()
+                        if ideal.piston_acceleration.size else [],
+                    "drive_power_mean_w": float(np.mean(ideal.drive_power[sel]))}
+    ist = statistics(ideal, rev_hz, t0, v_min)
+    res["ideal"]["main_bearing_per_rev_peak_n"] = ist["main_bearing_force"]["per_rev_peak"]["mean"]
+    res["ideal"]["main_bearing_rms_n"] = ist["main_bearing_force"]["rms"]["mean"]
+    for key, h in res["headline"].items():
+        if key in res["ideal"]:
+            h["ideal"] = res["ideal"][key]
 
-        res["flexible"] = flexible_results(mech, hist, rigid, sel, rev_hz, bodies,
-                                           warnings=res["warnings"])
-        res["flexible"]["rigid_integration_wall_time_s"] = None if rigid is None else rigid.wall_time
-        res["flexible"]["start"] = {"state": p["flexible"]["start"], **(start_info or {})}
-        from ..flexible.stepbound import step_bound
-        from .flexstage import flexible_bodies_of
 
-        bound = step_bound(flexible_bodies_of(mech), settings.method, t_end, hist.nfev,
-                           key_of=_flexible_key)
-        if bound is not None:
-            res["flexible"]["step_bound"] = bound
-    study = None
-    if p["solver"]["study_rtols"]:
-        rt = sorted(set(p["solver"]["study_rtols"]) | {settings.rtol / 10})
-        study = tolerance_study(mech, t_end, dt, rt, t_start=float(hist.t[sel][0]), base=settings,
-                                ensemble=res.get("ensemble"))
-        res["tolerance_study"] = study
-    arrays = hist.arrays()
-    if rigid is not None:
-        arrays.update({f"rigid_{k}": v for k, v in rigid.arrays().items()})
-    if ideal is not None:
-        arrays.update({f"ideal_{k}": v for k, v in ideal.arrays().items()})
-        for cj in mech.system.clearances:
-            beta, rate = force_direction(ideal.t, ideal.joint_forces[cj.name])
-            arrays[f"ideal_force_direction_{cj.name}"] = beta
-            arrays[f"ideal_force_direction_rate_{cj.name}"] = rate
+def _flexible_results(model: _Model, runs: _Runs, sel, p: dict, warnings: list) -> dict:
+    """The flexible bodies' results: modes kept, validity, flexible against the rigid twin,
+    the start and the step bound of their modes."""
+    from ..flexible.stepbound import step_bound
+    from .flexstage import flexible_bodies_of, flexible_results
+
+    out = flexible_results(model.mech, runs.hist, runs.rigid, sel, model.rev_hz, model.bodies,
+                           warnings=warnings)
+    out["rigid_integration_wall_time_s"] = None if runs.rigid is None else runs.rigid.wall_time
+    out["start"] = {"state": p["flexible"]["start"], **(model.start_info or {})}
+    bound = step_bound(flexible_bodies_of(model.mech), model.settings.method, model.t_end,
+                       runs.hist.nfev, key_of=_flexible_key)
+    if bound is not None:
+        out["step_bound"] = bound
+    return out
+
+
+def _tolerance_study(res: dict, model: _Model, hist, sel, p: dict) -> dict | None:
+    """The tolerance study (``solver.study_rtols``, and a tenth of ``rtol``) into ``res``."""
+    from ..run.simulate import tolerance_study
+
+    if not p["solver"]["study_rtols"]:
+        return None
+    rt = sorted(set(p["solver"]["study_rtols"]) | {model.settings.rtol / 10})
+    res["tolerance_study"] = tolerance_study(model.mech, model.t_end, model.dt, rt,
+                                             t_start=float(hist.t[sel][0]), base=model.settings,
+                                             ensemble=res.get("ensemble"))
+    return res["tolerance_study"]
+
+
+def _result(model: _Model, runs: _Runs, sel, n_rev: int, res: dict):
+    """The :class:`DynamicsResult` of the runs: ``res`` its summary, the main-bearing spectrum
+    over the window and the direction of each ideal pin's force."""
+    from ..results.result import DynamicsResult, MachineInfo
+    from ..results.signals import amplitude_spectrum, force_direction
+
+    hist = runs.hist
     spec = None
     if n_rev >= 1:
-        spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev_hz)
-        arrays["spectrum_frequency_hz"] = spec.frequency_hz
-        arrays["spectrum_order"] = spec.order
-        arrays["spectrum_main_bearing_amplitude"] = spec.amplitude
-    out = ctx.out_dir
-    with atomic_path(out / "dynamics.npz") as tmp:
-        np.savez_compressed(tmp, **arrays)
-    res["arrays"] = "dynamics.npz"
-    if ctx.figures:
-        res["figures"] = _figures(hist, ideal, mech, sel, study, out, spec)
-        if bodies is not None:
-            from ..results.flexplots import flexible_figures
+        spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], model.rev_hz)
+    directions = {}
+    if runs.ideal is not None:
+        directions = {cj.name: force_direction(runs.ideal.t, runs.ideal.joint_forces[cj.name])
+                      for cj in model.mech.system.clearances}
+    return DynamicsResult(history=hist, machine=MachineInfo.of(model.mech),
+                          window_s=tuple(res["peak_window_s"]), summary=res, ideal=runs.ideal,
+                          rigid=runs.rigid, spectrum=spec, ideal_force_direction=directions)
 
-            res["flexible"]["figures"] = flexible_figures(hist, rigid, mech, sel, out)
-            res["figures"] += res["flexible"]["figures"]
-    k = key_outputs(hist, rev_hz, float(hist.t[sel][0]))
-    n_imp = sum(j["impact_count"] for j in joints.values())
-    if mech.pistons:
-        motion = f"piston accel peak {k['peak_piston_acceleration']:.4g} m/s^2"
-    else:
-        motion = f"rocker accel peak {res['angular_acceleration_peak'].get('rocker', 0.0):.4g} rad/s^2"
+
+def _summary_line(res: dict, model: _Model, hist, sel, n_rev: int, study, p: dict) -> str:
+    """The one-line summary: the headline numbers (the ensemble's or per-revolution means for
+    a clearance run, peaks otherwise), impacts, energy balance, oil films, flexible bodies."""
     from ...report.quantity import number, quantity  # never e+NN in a summary (issue 25 #15)
+    from ..results.stats import converged_summary
+    from ..run.simulate import key_outputs
 
+    mech, rev_hz = model.mech, model.rev_hz
     if "ensemble" in res and n_rev >= 1 and study is None:
         # one value per quantity, with the ensemble's spread where the trajectories disagree
         # (with a tolerance study: its convergence summary over the ensemble, below)
@@ -358,41 +435,51 @@ def run(params: dict, ctx) -> dict:
         headline_text = ensemble_text(res["headline"], n_rev)
     elif mech.system.clearances and res["statistics"]["window"]["n_revolutions"] >= 2:
         # a clearance run: one trajectory's peak is not a result, the per-revolution mean is
-        headline_text = converged_summary(res["statistics"], study, settings.rtol,
+        headline_text = converged_summary(res["statistics"], study, model.settings.rtol,
                                           res.get("ensemble", {}).get("n_trajectories"))
     else:
+        k = key_outputs(hist, rev_hz, float(hist.t[sel][0]))
+        if mech.pistons:
+            motion = f"piston accel peak {k['peak_piston_acceleration']:.4g} m/s^2"
+        else:
+            motion = (f"rocker accel peak {res['angular_acceleration_peak'].get('rocker', 0.0):.4g}"
+                      f" rad/s^2")
         headline_text = (f"main-bearing peak {quantity(res['main_bearing_force_peak_n'], 'N')}, "
                          f"{motion}")
-    res["summary"] = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {t_end:g} s: {headline_text}, "
-                      f"{n_imp} impacts, energy balance "
-                      f"{number(res['energy_balance_error'], 2)}")
-    for name, j in joints.items():
+    n_imp = sum(j["impact_count"] for j in res["clearance_joints"].values())
+    text = (f"{mech.kind} at {60.0 * rev_hz:g} rpm, {model.t_end:g} s: {headline_text}, "
+            f"{n_imp} impacts, energy balance {number(res['energy_balance_error'], 2)}")
+    for name, j in res["clearance_joints"].items():
         if "min_film_thickness_m" in j:
-            res["summary"] += (f"; {name} oil film: thinnest {1e6 * j['min_film_thickness_m']:.3g}"
-                               f" um (eccentricity ratio {j['eccentricity_ratio_max']:.3g})")
+            text += (f"; {name} oil film: thinnest {1e6 * j['min_film_thickness_m']:.3g}"
+                     f" um (eccentricity ratio {j['eccentricity_ratio_max']:.3g})")
     if "ensemble" in res:
         from ...report.quantity import quantity_range  # 15.99–34.56 kN, not 1.599e+04-3.456e+04
 
         e = res["headline"]["main_bearing_per_rev_peak_n"]
-        res["summary"] += (f"; the {p['ensemble']} trajectories (started 10⁻¹² apart) range "
-                           f"{quantity_range(e['min'], e['max'], 'N')} in that peak")
-    if bodies is not None:
-        names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in res["flexible"]["bodies"].items())
-        res["summary"] += f"; flexible: {names}"
-        from ..results.validity import validity_summary
+        text += (f"; the {p['ensemble']} trajectories (started 10⁻¹² apart) range "
+                 f"{quantity_range(e['min'], e['max'], 'N')} in that peak")
+    if model.bodies is not None:
+        text += _flexible_summary(res["flexible"])
+    return text
 
-        res["summary"] += validity_summary(res["flexible"]["bodies"])
-        cmp = res["flexible"].get("rigid", {}).get("main_bearing")
-        if cmp:
-            res["summary"] += (f"; main bearing flexible vs rigid: peak {cmp['peak_n']:.4g} vs "
-                               f"{cmp['rigid_peak_n']:.4g} N, RMS of the difference "
-                               f"{100 * cmp['relative_difference_rms']:.2g} % of the rigid RMS")
-        sb = res["flexible"].get("step_bound")
-        if sb and sb["bound"]:
-            res["summary"] += (f"; {sb['method']} steps ({sb['mean_step_s']:.2g} s) bound by the "
-                               f"{sb['frequency_hz']:.4g} Hz mode of {sb['body']}")
-    ctx.products[SECTION] = {"mechanism": mech, "history": hist, "ideal": ideal, "rigid": rigid}
-    return res
+
+def _flexible_summary(flex: dict) -> str:
+    """The summary's flexible part: modes kept, validity, flexible against rigid, step bound."""
+    from ..results.validity import validity_summary
+
+    names = ", ".join(f"{n} {d['n_modes']} modes" for n, d in flex["bodies"].items())
+    text = f"; flexible: {names}" + validity_summary(flex["bodies"])
+    cmp = flex.get("rigid", {}).get("main_bearing")
+    if cmp:
+        text += (f"; main bearing flexible vs rigid: peak {cmp['peak_n']:.4g} vs "
+                 f"{cmp['rigid_peak_n']:.4g} N, RMS of the difference "
+                 f"{100 * cmp['relative_difference_rms']:.2g} % of the rigid RMS")
+    sb = flex.get("step_bound")
+    if sb and sb["bound"]:
+        text += (f"; {sb['method']} steps ({sb['mean_step_s']:.2g} s) bound by the "
+                 f"{sb['frequency_hz']:.4g} Hz mode of {sb['body']}")
+    return text
 
 
 def _flexible_key(body_name: str) -> str:
@@ -400,30 +487,3 @@ def _flexible_key(body_name: str) -> str:
     from .flexstage import flexible_key
 
     return flexible_key(body_name)
-
-
-def _figures(hist, ideal, mech, sel, study, out, spec=None):
-    """Write the PNG figures; ``spec``: the main-bearing spectrum if already computed."""
-    from ..results import plots
-    from ..results.signals import amplitude_spectrum
-
-    figs = []
-    rev = mech.revolution_hz
-    if spec is None:
-        spec = amplitude_spectrum(hist.t[sel], hist.main_bearing_force[sel], rev)
-    ispec = None if ideal is None else amplitude_spectrum(ideal.t[sel],
-                                                          ideal.main_bearing_force[sel], rev)
-    window = (float(hist.t[sel][0]), float(hist.t[sel][-1]))  # shaded on every time plot
-    figs.append(plots.plot_bearing_force(hist, spec, out / "dynamics_main_bearing.png", ispec,
-                                         ideal, window))
-    if hist.piston_acceleration.shape[1]:
-        figs.append(plots.plot_piston(hist, ideal, out / "dynamics_piston.png", window=window))
-    if mech.system.clearances:
-        cl = {cj.name: cj.clearance for cj in mech.system.clearances}
-        figs.append(plots.plot_orbit(hist, cl, out / "dynamics_orbit.png"))
-        figs.append(plots.plot_contact(hist, out / "dynamics_contact.png", ideal, window))
-    figs.append(plots.plot_drive(hist, ideal, out / "dynamics_drive.png", window))
-    figs.append(plots.plot_energy(hist, out / "dynamics_energy.png", ideal, window))
-    if study is not None:
-        figs.append(plots.plot_study(study, out / "dynamics_tolerance_study.png"))
-    return [f.name for f in figs]
