@@ -96,6 +96,10 @@ def applicable(sysm) -> bool:
     for ld in sysm.loads:
         if type(ld) not in (PistonLoads, CrankTorque, TorsionalCoupling):
             return False
+        if type(ld) is TorsionalCoupling:
+            if not all(isinstance(b, (*_BODIES, Ground)) for b in (ld.a, ld.b)):
+                return False
+            continue
         if not all(isinstance(b, _BODIES) for b in (getattr(ld, "piston", ld.crank), ld.crank)):
             return False
     return True

@@ -1,4 +1,5 @@
-"""Applied loads: gas force on a piston, piston (ring) friction, a torque on the crank.
+"""Applied loads: gas force on a piston, piston (ring) friction, a torque on the crank, a
+torsional coupling (spring and damper) between two bodies' frames.
 
 Each load adds its generalised force to ``Q`` and returns the power it delivers to the system (W).
 """
@@ -102,3 +103,64 @@ class CrankTorque:
         _, J, _ = sysm.frame(self.crank, self.frame, q, qd)
         sysm.add_frame_force(Q, self.crank, J, np.array([0.0, 0.0, self.torque]))
         return self.torque * float(sysm.frame_velocity(self.crank, J, qd)[2])
+
+
+@dataclass
+class TorsionalCoupling:
+    """A torsional spring and viscous damper between two frames (a flexible coupling).
+
+    The torque ``T = k (phi_b - phi_a - offset) + c (omega_b - omega_a)`` (N m) acts on frame
+    ``frame_a`` of body ``a`` and ``-T`` on frame ``frame_b`` of body ``b``: the coupling pulls
+    the two frames' angles together. Its elastic energy ``k tw^2 / 2`` is not part of the
+    bodies' energies: the load's power (returned, W) carries it, so the run's energy balance
+    closes with it in ``work_loads``.
+
+    Parameters
+    ----------
+    a, b : body
+        The two bodies (e.g. a motor rotor and the crank); either may be a ground.
+    frame_a, frame_b : str
+        Their frames.
+    stiffness : float
+        N m/rad, > 0.
+    damping : float
+        N m s/rad, >= 0.
+    offset : float
+        Angle of ``b`` relative to ``a`` at which the spring is relaxed, rad.
+
+    Raises
+    ------
+    ParameterError
+        ``stiffness`` <= 0 (named ``coupling_stiffness``), ``damping`` < 0 (named
+        ``coupling_damping``) or not finite.
+    """
+
+    a: object
+    frame_a: str
+    b: object
+    frame_b: str
+    stiffness: float
+    damping: float = 0.0
+    offset: float = 0.0
+
+    def __post_init__(self):
+        from ... import arguments as arg
+
+        self.stiffness = arg.number("coupling_stiffness", self.stiffness, gt=0.0)
+        self.damping = arg.number("coupling_damping", self.damping, ge=0.0)
+        self.offset = arg.number("offset", self.offset)
+
+    def coupling_torque(self, sysm, q, qd) -> tuple[float, object, object, float, float]:
+        """The coupling torque on ``a`` (N m), the frames' Jacobians and angular velocities."""
+        pa, Ja, _ = sysm.frame(self.a, self.frame_a, q, qd)
+        pb, Jb, _ = sysm.frame(self.b, self.frame_b, q, qd)
+        wa = float(sysm.frame_velocity(self.a, Ja, qd)[2])
+        wb = float(sysm.frame_velocity(self.b, Jb, qd)[2])
+        tq = self.stiffness * (pb[2] - pa[2] - self.offset) + self.damping * (wb - wa)
+        return tq, Ja, Jb, wa, wb
+
+    def forces(self, sysm, t, q, qd, Q) -> float:
+        tq, Ja, Jb, wa, wb = self.coupling_torque(sysm, q, qd)
+        sysm.add_frame_force(Q, self.a, Ja, np.array([0.0, 0.0, tq]))
+        sysm.add_frame_force(Q, self.b, Jb, np.array([0.0, 0.0, -tq]))
+        return tq * (wa - wb)

@@ -17,9 +17,10 @@ import numpy as np
 
 from ...errors import ParameterError
 from .bodies import Ground, RigidBody
-from .clearance import ClearanceJoint
+from .clearance import ClearanceSpec
 from .joints import AngleDrive, Prismatic, Revolute, SpeedProfile
-from .loads import CrankTorque, PistonLoads
+from .layout import body_reference_angle, single_pin_layout, throw_layout
+from .loads import CrankTorque, PistonLoads, TorsionalCoupling
 from .system import Multibody
 
 
@@ -156,6 +157,20 @@ class Mechanism:
         The main bearing's joint name(s) and the rows' axial positions (m).
     start, start_info
         How the initial state was found (``quasi_static`` or ``undeformed``) and its record.
+    arrangement, layout
+        The crank train's :class:`~crankmodal.mechanism.arrangement.Arrangement` (None: one
+        crankpin) and its :class:`~.layout.ThrowLayout` (throws, pin angles, top dead centres).
+    reference_angle : float
+        Angle of the reference throw in the crank's body axes, rad (0 for a rigid crank): the
+        reference crank angle is the crank's body angle plus it.
+    journals_z : list or None
+        A rigid crank's two main journals' axial positions, m (the lever-rule split).
+    motor : RigidBody or None
+        The motor rotor of a :class:`~.drive.MotorDrive`.
+    pin_frames : list of str
+        The crank frame carrying each cylinder's rod.
+    drive_frame : str
+        The crank frame the drive (or the motor's coupling) acts on.
     """
 
     kind: str
@@ -172,6 +187,13 @@ class Mechanism:
     main_joints: list = field(default_factory=list)
     start: str = "quasi_static"
     start_info: dict | None = None
+    arrangement: object = None
+    layout: object = None
+    reference_angle: float = 0.0
+    journals_z: list | None = None
+    motor: RigidBody | None = None
+    pin_frames: list = field(default_factory=list)
+    drive_frame: str = "main"
 
     def __post_init__(self):
         if not self.main_joints:
@@ -221,34 +243,86 @@ def _unit(angle):
     return np.array([np.cos(angle), np.sin(angle)])
 
 
-def _split(pins, clearance_specs, contact_kw):
-    """Ideal pins and clearance joints from the pin list and {name: spec}."""
+def _split(pins, clearances, contact_kw):
+    """Ideal pins and clearance joints from the pin list and ``{name: ClearanceSpec}`` (or the
+    deprecated dict form, converted by :func:`clearance_specs`)."""
     from ... import arguments as arg
 
-    clearance_specs = arg.table("clearances", clearance_specs, {p.name for p in pins})
-    contact_kw = arg.table("contact_kw", contact_kw, CONTACT_KW)
+    specs = clearances or {}
+    if not hasattr(specs, "values"):
+        raise ParameterError("clearances", f"must be a mapping {{joint: ClearanceSpec}}, got "
+                             f"{specs!r:.60}")
+    if contact_kw or any(not isinstance(v, ClearanceSpec) for v in dict(specs).values()):
+        specs = clearance_specs(specs, contact_kw, stacklevel=4)
+    specs = arg.table("clearances", specs, {p.name for p in pins})
     ideal_pins, clear = [], []
     for p in pins:
-        spec = clearance_specs.get(p.name)
+        spec = specs.get(p.name)
         if spec is None:
             ideal_pins.append(p)
             continue
-        spec = _clearance_spec(f"clearances.{p.name}", spec)
+        clear.append(spec.joint(p.name, p.a, p.frame_a, p.b, p.frame_b))
+    return ideal_pins, clear
+
+
+def clearance_specs(clearances, contact_kw=None, stacklevel: int = 2) -> dict:
+    """``{joint: ClearanceSpec}`` from the deprecated dict form of ``clearances``.
+
+    The one edge where the dictionaries of the old Python API (``clearances = {joint: {
+    "clearance", "journal_radius", "contact": {...}}}`` with shared ``contact_kw = {"law",
+    "law_params", "friction", "friction_params", "v_impact_min"}``) become typed
+    :class:`~.clearance.ClearanceSpec` objects; it issues one :class:`DeprecationWarning`.
+    Entries that are ClearanceSpecs already pass unchanged.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``clearances.<joint>.<key>`` or ``contact_kw`` (and, for a missing contact
+        stiffness, the scenes' default for steel on steel).
+    """
+    import warnings
+
+    from ... import arguments as arg
+    from ..laws.objects import legacy_laws
+
+    clearances = arg.table("clearances", clearances or {}, set(clearances or {}))
+    contact_kw = arg.table("contact_kw", contact_kw or {}, CONTACT_KW)
+    out = {}
+    for name, spec in clearances.items():
+        if isinstance(spec, ClearanceSpec):
+            out[name] = spec
+            continue
+        spec = _clearance_spec(f"clearances.{name}", spec)
         kw = dict(contact_kw)
         kw.update(spec.get("contact") or {})  # per-joint overrides (a stiffness from the radii)
         try:
-            clear.append(ClearanceJoint(
-                name=p.name, journal=p.a, journal_frame=p.frame_a, bearing=p.b,
-                bearing_frame=p.frame_b, clearance=spec["clearance"],
-                journal_radius=spec["journal_radius"], clearance_major=spec.get("clearance_major"),
-                wear_angle=spec.get("wear_angle", 0.0), viscosity=spec.get("viscosity"),
-                bearing_length=spec.get("bearing_length") or 0.0,
-                film_model=spec.get("film_model", "short"), **kw))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", DeprecationWarning)
+                normal, friction = legacy_laws(kw.get("law", "impact"), kw.get("law_params"),
+                                               kw.get("friction"), kw.get("friction_params"))
         except (ValueError, TypeError) as exc:  # the law objects' own checks (ParameterError)
-            where = f"clearances.{p.name}.contact" if spec.get("contact") else "contact_kw"
-            raise ParameterError(where, f"joint {p.name!r}: {exc}"
+            where = f"clearances.{name}.contact" if spec.get("contact") else "contact_kw"
+            raise ParameterError(where, f"joint {name!r}: {exc}"
                                  + _stiffness_hint(kw, spec)) from None
-    return ideal_pins, clear
+        try:
+            out[name] = ClearanceSpec(
+                clearance=spec["clearance"], journal_radius=spec["journal_radius"],
+                normal=normal, friction=friction,
+                v_impact_min=kw.get("v_impact_min", 1e-3),
+                clearance_major=spec.get("clearance_major"),
+                wear_angle=spec.get("wear_angle", 0.0), viscosity=spec.get("viscosity"),
+                bearing_length=spec.get("bearing_length") or None,
+                film_model=spec.get("film_model", "short"))
+        except ParameterError as exc:
+            where = "contact_kw.v_impact_min" if exc.argument == "v_impact_min" \
+                else f"clearances.{name}.{exc.argument}"
+            raise ParameterError(where, exc.text) from None
+    if any(not isinstance(v, ClearanceSpec) for v in clearances.values()) or contact_kw:
+        warnings.warn("clearances as dicts with contact_kw are deprecated: pass {joint: "
+                      "ClearanceSpec(clearance, journal_radius, normal=<NormalLaw>, "
+                      "friction=<FrictionLaw>, ...)}", DeprecationWarning,
+                      stacklevel=stacklevel)
+    return out
 
 
 #: keys of ``contact_kw`` (the clearance joints' shared law settings)
@@ -302,9 +376,13 @@ def _finish(kind, bodies, pins, others, loads, clearance_specs, contact_kw, q0, 
     assembly = Multibody(bodies, pins + others, [], loads, gravity, baumgarte)
     q, qd = assembly.assemble(0.0, q0, qd0)
     extra = []
-    if not isinstance(drive, AngleDrive):  # free speed: assembled at omega0, then torque-driven
+    if not any(c is drive for c in others):
+        # free speed: assembled at omega0, then torque-driven; or a motor's drive
         others = [c for c in others if not isinstance(c, AngleDrive)]
-        extra = [drive]
+        if isinstance(drive, AngleDrive):
+            others.append(drive)
+        else:
+            extra = [drive]
     ideal = Multibody(bodies, pins + others, [], loads + extra, gravity, baumgarte)
     _check_rank(ideal, q, f"{kind} with {len(bodies)} bodies", body_argument)
     system = Multibody(bodies, ideal_pins + others, clear, loads + extra, gravity, baumgarte)
@@ -396,8 +474,14 @@ def _drive(crank, omega, theta0, ramp_time, drive_torque, crank_frame="main"):
 def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inertia=0.0,
                 crank_com=0.0, theta0=0.0, ramp_time=0.0, drive_torque=None, clearances=None,
                 contact_kw=None, gravity=(0.0, 0.0), baumgarte=None, kind="slider_crank",
-                direction=1, crank_body=None, crank_roles=None, rod_bodies=None):
-    """Slider-crank train: one crank, ``len(cylinders)`` rods on one crankpin, pistons.
+                direction=1, crank_body=None, crank_roles=None, rod_bodies=None,
+                arrangement=None, journals_z=None, motor=None):
+    """Crank train: one crank, ``len(cylinders)`` rods on its crankpins, pistons.
+
+    Without ``arrangement`` every rod sits on one crankpin (slider-crank, V, four-star). With
+    one (:class:`~crankmodal.mechanism.arrangement.Arrangement`, the machine description the
+    forced torsion reads too), each cylinder works on its throw at the throw's phase, and a
+    four-stroke gas cycle is phased by the firing order (:mod:`.layout`).
 
     The crank and the rods are rigid bodies made from the parameters, or the body objects given
     (e.g. flexible ones, :mod:`~.flexbuild`): ``crank_body`` with ``crank_roles`` naming its
@@ -448,13 +532,28 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         frames :func:`~.flexbuild.crank_body` makes (``main_1``…, ``pin_1``…, ``drive``).
     rod_bodies : list, optional
         One body (or None: rigid) per cylinder, frames ``big`` and ``small``.
+    arrangement : Arrangement, optional
+        Throws (phases ahead of the reference crank in the sense of rotation), each cylinder's
+        throw and bank angle (its ``axis_angle`` must be ``90 deg - bank``), and the firing
+        order of a four-stroke cycle (each cylinder's ``gas_force`` is then read from its
+        firing top dead centre, over 720 deg). A rigid crank gets one pin frame per throw
+        (``pin_1``…); a ``crank_body``'s pin frames must lie at their throws' phases.
+    journals_z : sequence of float, optional
+        Rigid crank only: the axial positions of its main journals, m (the cylinders' ``z`` in
+        the same axis). Two journals: the main-bearing force is split between them by the
+        lever rule (statically determinate; outputs ``main_1``, ``main_2``); more than two
+        are statically indeterminate and refused: give a flexible ``crank_body``.
+    motor : MotorDrive, optional
+        A motor rotor coupled to the crank's drive frame through a torsional coupling
+        (:mod:`.drive`): the prescribed speed (or ``drive_torque``) then acts on the motor,
+        and the train's torsional modes appear. A rigid crank then needs ``crank_inertia > 0``.
 
     Raises
     ------
     ParameterError
         An argument out of its range, naming it (``crank_radius``, ``cylinders[0].rod_length``,
-        ``clearances.main.clearance``, ``crank_roles``…); the bounds are those of the
-        ``[dynamics]`` scene keys.
+        ``clearances.main.clearance``, ``crank_roles``, ``arrangement.cylinder_throws``,
+        ``journals_z``, ``motor``…); the bounds are those of the ``[dynamics]`` scene keys.
     """
     from ... import arguments as arg
     from ..scene.keys import CRANK_TRAIN
@@ -512,24 +611,62 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     if drive_torque is not None and crank_body is None and crank_inertia <= 0.0:
         raise ParameterError("crank_inertia", "must be > 0 (crank and flywheel, kg m^2) when "
                              "drive_torque sets the speed free")
+    if motor is not None:
+        from .drive import MotorDrive
+
+        arg.instance("motor", motor, MotorDrive, "a MotorDrive(inertia, coupling_stiffness, "
+                     "coupling_damping)")
+        if crank_body is None and crank_inertia <= 0.0:
+            raise ParameterError("crank_inertia", "must be > 0 (crank and flywheel, kg m^2) "
+                                 "with a motor: the crank turns on the coupling")
+    if arrangement is None:
+        layout = single_pin_layout([c.axis_angle for c in cylinders])
+    else:
+        layout = throw_layout(arrangement, [c.axis_angle for c in cylinders], direction)
+    if journals_z is not None:
+        journals_z = arg.numbers("journals_z", journals_z)
+        if crank_body is not None:
+            raise ParameterError("journals_z", "is for a rigid crank made from the parameters; "
+                                 "a crank body's main journals are its frames (crank_roles)")
+        if len(journals_z) > 2:
+            raise RedundantJoints("journals_z", f"a rigid crank on {len(journals_z)} main "
+                                  "journals is statically indeterminate (only the crank's "
+                                  "flexibility shares the load): give a flexible crank_body")
+        if len(journals_z) == 2 and journals_z[0] == journals_z[1]:
+            raise ParameterError("journals_z", "the two journals must be at different axial "
+                                 f"positions, got {journals_z}")
     omega = direction * speed_rpm * 2.0 * np.pi / 60.0
     baumgarte = max(50.0, 2.0 * abs(omega)) if baumgarte is None else baumgarte
     ground = Ground(frames={"main": (0.0, 0.0)})
     r, b = crank_radius, crank_com
     rw = omega if ramp_time <= 0.0 else 0.0
-    c0, s0 = np.cos(theta0), np.sin(theta0)
-    A0 = np.array([[c0, -s0], [s0, c0]])
+    reference = 0.0  # angle of the reference throw in the crank's body axes
     if crank_body is None:
-        crank = RigidBody("crank", max(crank_mass, 0.0), max(crank_inertia, 1e-12),
-                          {"main": (-b, 0.0), "pin": (r - b, 0.0)})
-        mains, pin_frames, drive_frame = ["main"], ["pin"] * len(cylinders), "main"
+        frames = {"main": (-b, 0.0)}
+        if layout.n_throws == 1 and layout.pin_angles[0] == 0.0:
+            frames["pin"] = (r - b, 0.0)
+            throw_frames = ["pin"]
+        else:
+            throw_frames = [f"pin_{t}" for t in range(1, layout.n_throws + 1)]
+            for name, a in zip(throw_frames, layout.pin_angles):
+                frames[name] = (r * np.cos(a) - b, r * np.sin(a))
+        z_crank = 0.0 if not journals_z else float(np.mean(journals_z))
+        crank = RigidBody("crank", max(crank_mass, 0.0), max(crank_inertia, 1e-12), frames,
+                          z=z_crank)
+        mains, drive_frame = ["main"], "main"
+        pin_frames = [throw_frames[t] for t in layout.throws]
+        c0, s0 = np.cos(theta0), np.sin(theta0)
         q_crank = np.array([b * c0, b * s0, theta0])
     else:
         crank = crank_body
         mains, pin_frames = list(crank_roles["mains"]), list(crank_roles["pins"])
         drive_frame = crank_roles["drive"]
+        if arrangement is not None:
+            reference = body_reference_angle(crank, mains[0], pin_frames, layout)
+        th = theta0 - reference
+        A0 = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
         s_main = crank.local(mains[0])[0]  # undeformed, body axes
-        q_crank = np.concatenate([-A0 @ s_main, [theta0], np.zeros(crank.ndof - 3)])
+        q_crank = np.concatenate([-A0 @ s_main, [th], np.zeros(crank.ndof - 3)])
     # rigid rotation about the axis at rw: v = rw e_z x (position of the frame origin)
     qd_crank = np.zeros(crank.ndof)
     qd_crank[:3] = [-q_crank[1] * rw, q_crank[0] * rw, rw]
@@ -537,8 +674,19 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     main_names = ["main"] if len(mains) == 1 else [f"main_{j}" for j in range(1, len(mains) + 1)]
     pins = [Revolute(nm, crank, fr, ground, "main") for nm, fr in zip(main_names, mains)]
     others, loads, pistons, axes, rows_z = [], [], [], [], {}
-    angle_drive, drive = _drive(crank, omega, theta0, ramp_time, drive_torque, drive_frame)
+    angle_drive, drive = _drive(crank, omega, theta0 - reference, ramp_time, drive_torque,
+                                drive_frame)
     others.append(angle_drive)
+    motor_body = None
+    if motor is not None:
+        motor_body, drive = _motor(motor, crank, drive_frame, q_crank, omega, ramp_time,
+                                   drive_torque)
+        bodies.append(motor_body)
+        q0 += [0.0, 0.0, float(crank.frame_pose(q_crank, drive_frame)[2])]
+        qd0 += [0.0, 0.0, rw]
+        pins.append(Revolute("motor_bearing", motor_body, "shaft", ground, "main"))
+        loads.append(TorsionalCoupling(motor_body, "shaft", crank, drive_frame,
+                                       motor.coupling_stiffness, motor.coupling_damping))
     for i, cyl in enumerate(cylinders, start=1):
         u = _unit(cyl.axis_angle)
         nrm = np.array([-u[1], u[0]])
@@ -570,7 +718,10 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         pins += [Revolute(f"big_end_{i}", crank, pin_frames[i - 1], rod, "big"),
                  Revolute(f"small_end_{i}", piston, "pin", rod, "small")]
         others.append(Prismatic(f"slider_{i}", piston, "pin", cyl.offset * nrm, u, cyl.axis_angle))
-        loads.append(PistonLoads(piston, "pin", u, cyl.axis_angle, crank, mains[0],
+        # the crank angle is read at the first main journal: its body angle (reference less
+        # the reference throw's angle in the body axes)
+        tdc = layout.firing_tdc_angles[i - 1] - reference
+        loads.append(PistonLoads(piston, "pin", u, tdc, crank, mains[0],
                                  cyl.gas_force, cyl.ring_friction, sense=direction))
         pistons.append(piston)
         axes.append(u)
@@ -579,7 +730,23 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
                    np.array(q0), np.array(qd0), crank, drive, gravity, baumgarte,
                    pistons=pistons, axes=axes, revolution_hz=speed_rpm / 60.0, rows_z=rows_z,
                    main_joint=main_names[0], main_joints=main_names,
-                   body_argument="crank_body" if crank_body is not None else "cylinders")
+                   body_argument="crank_body" if crank_body is not None else "cylinders",
+                   arrangement=arrangement, layout=layout, reference_angle=reference,
+                   journals_z=None if journals_z is None else list(journals_z),
+                   motor=motor_body, pin_frames=pin_frames, drive_frame=drive_frame)
+
+
+def _motor(motor, crank, drive_frame, q_crank, omega, ramp_time, drive_torque):
+    """The motor rotor (a rigid body on the crank axis, its coupling relaxed at the start) and
+    the drive of the run acting on it: its prescribed angle, or ``drive_torque``."""
+    rotor = RigidBody("motor", 0.0, motor.inertia, {"shaft": (0.0, 0.0)})
+    start = float(crank.frame_pose(q_crank, drive_frame)[2])
+    omega_start = 0.0 if ramp_time > 0.0 else omega
+    if drive_torque is not None:
+        return rotor, CrankTorque(rotor, "shaft", drive_torque)
+    # the motor's angle runs from the crank drive frame's: the coupling starts relaxed
+    profile = SpeedProfile(omega, start, ramp_time, omega_start)
+    return rotor, AngleDrive("drive", rotor, "shaft", profile)
 
 
 #: relative tolerance on the distance between a link body's two joint frames and its length

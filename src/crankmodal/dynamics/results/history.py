@@ -13,6 +13,7 @@ import numpy as np
 
 from ..model.joints import AngleDrive, Revolute
 from ..model.system import AUX_NAMES, N_AUX
+from .torsional import torsion_histories
 
 
 @dataclass
@@ -48,6 +49,10 @@ class History:
         (magnitude, N) and ``piston_acceleration`` (n, P) (m/s^2) at that instant.
     modal : dict body name -> (K, k) the flexible bodies' modal coordinates (elastic, then
         tilts), m kg^½ (tilts in rad).
+    torsion : dict name -> (K,) torsional histories of a crank train with a motor or a
+        flexible crank (:func:`.torsional.torsion_histories`: ``motor_angle`` rad,
+        ``motor_speed`` rad/s, ``coupling_twist`` rad, ``coupling_torque`` N m,
+        ``twist_<frame>``, ``twist_free_end`` rad).
     """
 
     t: np.ndarray
@@ -71,6 +76,7 @@ class History:
     nfev: int = 0
     wall_time: float = 0.0
     modal: dict = field(default_factory=dict)
+    torsion: dict = field(default_factory=dict)
 
     def energy_error(self) -> float:
         """Largest ``|residual|`` of the energy balance relative to the energy exchanged in the run
@@ -122,6 +128,8 @@ class History:
                 out[f"peaks_{name}_{k}"] = v
         for name, v in self.modal.items():
             out[f"modal_{name}"] = v
+        for name, v in self.torsion.items():
+            out[f"torsion_{name}"] = v
         return out
 
     def peak(self, key: str, sampled, name: str | None = None, since: float | None = None,
@@ -243,7 +251,8 @@ def record(mech, sysm, integ) -> History:
                                 for i, cj in enumerate(sysm.clearances)},
                    peaks=_record_peaks(mech, sysm, integ, pins),
                    modal={b.name: integ.y[sysm.slices[id(b)].start + 3: sysm.slices[id(b)].stop].T
-                          .copy() for b in getattr(sysm, "_elastic", ())})
+                          .copy() for b in getattr(sysm, "_elastic", ())},
+                   torsion=torsion_histories(mech, sysm, integ))
 
 
 def _main_joints(mech) -> list:
