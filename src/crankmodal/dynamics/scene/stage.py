@@ -195,7 +195,7 @@ def run(params: dict, ctx) -> dict:
     result.save(ctx.out_dir / "dynamics.npz")
     ctx.products[SECTION] = {"mechanism": model.mech, "history": runs.hist, "ideal": runs.ideal,
                              "rigid": runs.rigid, "result": result}
-    return res
+    return dict(res)  # the runner adds its wall_time_s to the copy, not to the saved summary
 
 
 def _model(p: dict, ctx) -> _Model:
@@ -329,8 +329,8 @@ def _joint_results(model: _Model, runs: _Runs, sel, p: dict) -> dict:
         if text:
             warn(text, into=model.warnings)
         if ideal is not None:
-            j["contact_loss"] = contact_loss_indicator(ideal.t[sel], ideal.joint_forces[cj.name][sel],
-                                                       ideal.crank_angle[sel])
+            j["contact_loss"] = contact_loss_indicator(
+                ideal.t[sel], ideal.joint_forces[cj.name][sel], ideal.crank_angle[sel])
         if getattr(cj, "viscosity", None):
             j["min_film_thickness_m"] = max(cj.clearance * (1.0 - j["eccentricity_ratio_max"]),
                                             0.0)
