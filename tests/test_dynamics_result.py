@@ -83,7 +83,7 @@ def _same_history(h, g) -> None:
               "drive_torque", "drive_power", "constraint_drift"):
         np.testing.assert_allclose(getattr(g, k), getattr(h, k), rtol=1e-12, atol=0.0,
                                    err_msg=k)
-    for attr in ("joint_forces", "energy", "angular_acceleration", "modal"):
+    for attr in ("joint_forces", "energy", "angular_acceleration", "modal", "torsion"):
         a, b = getattr(h, attr), getattr(g, attr)
         assert list(a) == list(b), attr
         for k in a:
@@ -126,6 +126,18 @@ def test_saved_result_loads_back_equal_to_the_run(stage_run, tmp_path):
     again = DynamicsResult.load(loaded.save(tmp_path / "again.npz"))
     for k, v in again.arrays().items():
         np.testing.assert_allclose(v, a[k], rtol=1e-12, atol=0.0, err_msg=k)
+
+
+def test_torsional_histories_round_trip(stage_run, tmp_path):
+    """A crank train with a motor or a flexible crank records ``torsion`` histories
+    (``torsion_<name>`` in the file): they come back by name, whatever underscores it holds."""
+    out, _, _ = stage_run
+    result = DynamicsResult.load(out / "dynamics.npz")
+    t = result.history.t
+    result.history.torsion = {"motor_speed": 300.0 + np.sin(t), "twist_free_end": 1e-3 * t}
+    loaded = DynamicsResult.load(result.save(tmp_path / "torsion.npz"))
+    _same_history(result.history, loaded.history)
+    assert list(loaded.history.torsion) == ["motor_speed", "twist_free_end"]
 
 
 def test_loaded_result_draws_the_stage_figures(stage_run, tmp_path):

@@ -330,4 +330,5 @@ def _layout(h: History | None) -> dict | None:
             "energy": list(h.energy), "angular_acceleration": list(h.angular_acceleration),
             "onsets": list(h.onsets), "separations": list(h.separations),
             "peaks": {n: list(d) for n, d in h.peaks.items()}, "modal": list(h.modal),
+            "torsion": list(getattr(h, "torsion", {})),
             "nfev": int(h.nfev), "wall_time": float(h.wall_time)}

@@ -226,6 +226,10 @@ def _history(m: _Members, prefix: str, lay, P: int) -> History:
         n = m.floats(f"{prefix}peaks_{name}_t", (None,)).shape[0]
         peaks[name] = {k: m.floats(f"{prefix}peaks_{name}_{k}",
                                    (n, P) if k == "piston_acceleration" else (n,)) for k in keys}
+    extra = {}
+    if "torsion" in lay:  # a crank train with a motor or a flexible crank
+        extra["torsion"] = {n: series(f"torsion_{n}")
+                            for n in _names(m, lay["torsion"], f"{where}.torsion")}
     nfev, wall = lay.get("nfev"), lay.get("wall_time")
     if not isinstance(nfev, int) or isinstance(nfev, bool) or nfev < 0:
         raise m.fail("meta_json", f"{where}.nfev: must be an integer >= 0")
@@ -243,7 +247,7 @@ def _history(m: _Members, prefix: str, lay, P: int) -> History:
             m, lay.get("angular_acceleration"), f"{where}.angular_acceleration")},
         peaks=peaks, nfev=nfev, wall_time=_number(m, wall, f"{where}.wall_time", strict=False),
         modal={n: series(f"modal_{n}", (K, None))
-               for n in _names(m, lay.get("modal"), f"{where}.modal")})
+               for n in _names(m, lay.get("modal"), f"{where}.modal")}, **extra)
 
 
 def _consistent(m: _Members, h: History, machine: MachineInfo) -> None:
