@@ -142,8 +142,8 @@ def system_method(sysm, omega: float | None = None, qd0=None) -> str:
         spins = [abs(float(qd0[sysm.slices[id(b)].start + 2])) for b in sysm.bodies] \
             if qd0 is not None else []
         omega = max(drives or spins or [0.0])
-    joints = [(cj.journal_radius, cj.friction,
-               float(cj.friction_law.params().get("v_dynamic", 0.0)), cj.viscosity is not None)
+    joints = [(cj.journal_radius, cj.friction.name,
+               float(getattr(cj.friction, "v_dynamic", 0.0)), cj.viscosity is not None)
               for cj in sysm.clearances]
     flexible = any(getattr(b, "n_elastic", 0) > 0 for b in sysm.bodies)
     return auto_method(joints, omega, flexible)
@@ -226,7 +226,7 @@ def _stiffness_advice(sysm, settings: SolverSettings | None = None) -> str:
                 f"{ts.describe()}: lower {ts.key}, use solver.method = {other}, or raise "
                 f"solver.max_rhs_evals")
     cj = sysm.clearances[0]
-    K = cj.law_params.get("stiffness", float("nan"))
+    K = getattr(cj.law, "stiffness", float("nan"))
     return (f"the contact of joint {cj.name!r} is the stiff part (contact.stiffness = {K:.3g}, "
             f"clearance = {cj.clearance:.3g} m) or its friction near stiction: lower "
             f"contact.stiffness, use solver.method = {other}, or raise solver.max_rhs_evals")

@@ -308,8 +308,8 @@ def _joint_results(model: _Model, runs: _Runs, sel, p: dict) -> dict:
     for cj in model.mech.system.clearances:
         d = hist.contact[cj.name]
         dur = contact_durations(hist.onsets[cj.name], hist.separations[cj.name])
-        j = {"clearance_m": cj.clearance, "law": cj.law,
-             "stiffness": float(cj.law_params["stiffness"]),
+        j = {"clearance_m": cj.clearance, "law": cj.law.name,
+             "stiffness": float(cj.law.stiffness),
              "peak_contact_force_n": hist.peak("fn", d["fn"][sel], cj.name, *tw),
              "max_penetration_m": hist.peak("penetration",
                                             np.maximum(d["penetration"][sel], 0.0), cj.name, *tw),
