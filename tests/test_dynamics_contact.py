@@ -115,7 +115,7 @@ def test_spinning_journal_friction_energy_is_booked(friction):
                   SolverSettings(rtol=1e-8, atol=1e-13)).y
     ke0 = sysm.energy(np.zeros(3), np.array([0.5, 0.2, 200.0]))[0]
     ke, _ = sysm.energy(y[:3, -1], y[3:6, -1])
-    el = sum(float(contact.elastic_energy(cj.law, cj.gap(sysm, y[:3, -1]), cj.law_params))
+    el = sum(float(contact.elastic_energy(cj.law.name, cj.gap(sysm, y[:3, -1]), cj.law.params()))
              for cj in sysm.clearances)
     d_contact = y[6 + AUX_NAMES.index("dissipated_contact"), -1]
     d_friction = y[6 + AUX_NAMES.index("dissipated_friction"), -1]
@@ -167,7 +167,7 @@ def test_worn_bore_contact_on_a_spinning_bearing_conserves_energy():
     y = out.y[:, -1]
     ke0 = sysm.energy(q0, qd0)[0]
     ke = sysm.energy(y[:6], y[6:12])[0]
-    el = float(contact.elastic_energy("hertz", joint.gap(sysm, y[:6]), joint.law_params))
+    el = float(contact.elastic_energy("hertz", joint.gap(sysm, y[:6]), joint.law.params()))
     assert len(out.onsets[0]) >= 2
     assert ke + el == pytest.approx(ke0, rel=1e-6)
 
@@ -209,7 +209,7 @@ def test_the_deepest_point_of_an_impact_is_an_event_however_coarse_the_output():
         k = joint.kinematics(sysm, y[:3], y[3:6])
         assert k["delta"] == pytest.approx(d_max, rel=1e-6)
         assert abs(k["delta_dot"]) < 1e-6 * v0
-        assert contact.normal_force("hertz", k["delta"], k["delta_dot"], joint.law_params,
+        assert contact.normal_force("hertz", k["delta"], k["delta_dot"], joint.law.params(),
                                     v0) == pytest.approx(K * d_max**1.5, rel=2e-6)
 
 

@@ -117,17 +117,19 @@ def test_clearance_joint_takes_names_or_objects_alike():
     ground = Ground(frames={"bore": (0.0, 0.0)})
     journal = RigidBody("journal", 1.0, 1e-3, {"centre": (0.0, 0.0)})
     fp = {"mu_static": 0.2, "mu_dynamic": 0.15, "v_static": 1e-4, "v_dynamic": 1e-2}
-    by_name = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
-                             journal_radius=0.01, law="impact", law_params=FULL,
-                             friction="coulomb", friction_params=fp)
+    with pytest.warns(DeprecationWarning, match="law='impact', law_params"):
+        by_name = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
+                                 journal_radius=0.01, law="impact", law_params=FULL,
+                                 friction="coulomb", friction_params=fp)
     obj = laws.Impact(stiffness=3e10, exponent=1.4, damping=450.0, penetration=5e-5)
     by_obj = ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
                             journal_radius=0.01, law=obj, friction=laws.Coulomb(**fp))
-    assert by_name.normal == by_obj.normal == obj
-    assert by_name.friction_law == by_obj.friction_law
-    # the names stay strings (results.json's clearance_joints.*.law) and the parameters dicts
-    assert by_obj.law == by_name.law == "impact" and by_obj.friction == "coulomb"
-    assert by_obj.law_params["stiffness"] == 3e10 and by_obj.friction_params == fp
+    assert by_name.law == by_obj.law == obj and by_name.normal == obj
+    assert by_name.friction == by_obj.friction == by_obj.friction_law == laws.Coulomb(**fp)
+    # the joint keeps the objects only; their names are the law's (results.json's
+    # clearance_joints.*.law)
+    assert by_obj.law.name == "impact" and by_obj.friction.name == "coulomb"
+    assert by_name.law_params is None and by_name.friction_params is None
     assert not by_obj.needs_memory
     assert ClearanceJoint("c", journal, "centre", ground, "bore", clearance=1e-4,
                           journal_radius=0.01, law=laws.Flores(stiffness=1e10,

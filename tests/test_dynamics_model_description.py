@@ -53,3 +53,109 @@ def test_clearance_spec_makes_the_joint_it_describes():
     cj = spec.joint("pin", b, "p", g, "o")
     assert cj.normal is LAW and cj.friction_law is fr
     assert (cj.clearance, cj.clearance_major, cj.wear_angle) == (1e-4, 1.5e-4, 0.3)
+
+
+# --- the core names its arguments; the stage relabels them with scene keys ---------------------
+
+@pytest.mark.parametrize("make, argument", [
+    (lambda: Impact(stiffness=-1e10, damping=300.0, penetration=1e-4), "stiffness"),
+    (lambda: Coulomb(mu_static=0.1, mu_dynamic=0.08, v_static=1e-2, v_dynamic=1e-4),
+     "v_dynamic"),
+])
+def test_a_bad_law_parameter_names_the_argument_not_a_scene_key(make, argument):
+    with pytest.raises(ParameterError) as err:
+        make()
+    assert err.value.argument == argument and "dynamics" not in str(err.value)
+
+
+def test_a_bad_law_parameter_by_name_names_the_argument():
+    from crankmodal.dynamics.model.bodies import Ground, RigidBody
+    from crankmodal.dynamics.model.clearance import ClearanceJoint
+
+    g = Ground(frames={"o": (0.0, 0.0)})
+    b = RigidBody("b", 1.0, 1e-3, frames={"p": (0.0, 0.0)})
+    with pytest.raises(ParameterError) as err:  # refused before the deprecation warning
+        ClearanceJoint("c", b, "p", g, "o", 1e-4, 0.02, law="impact",
+                       law_params={"stiffness": 1e10, "damping": -3.0, "penetration": 1e-4})
+    assert err.value.argument == "damping" and "dynamics" not in str(err.value)
+    with pytest.raises(ParameterError) as err:
+        ClearanceJoint("c", b, "p", g, "o", 1e-4, 0.02)
+    assert err.value.argument == "law"
+
+
+SCENE = """
+[dynamics]
+mechanism = "slider_crank"
+speed_rpm = 3000.0
+end_time = 0.01
+[dynamics.crank_train]
+crank_radius = 0.035
+rod_length = 0.14
+[[dynamics.clearances]]
+joint = "big_end_1"
+clearance = 1e-4
+journal_radius = 0.02
+{clearance}
+[dynamics.contact]
+law = "lankarani_nikravesh"
+stiffness = 1e10
+[dynamics.friction]
+law = "coulomb"
+{friction}
+"""
+
+
+@pytest.mark.parametrize("clearance, friction, message", [
+    ("", "v_static = 1e-2\nv_dynamic = 1e-4",
+     "dynamics.friction.v_dynamic: must be > v_static (0.01 m/s), got 0.0001"),
+    ("clearance_major = 5e-5", "",
+     "dynamics.clearances[0].clearance_major: must be >= clearance (0.0001 m), got 5e-05"),
+    ("viscosity = 0.01", "",
+     "dynamics.clearances[0].bearing_length: is required with viscosity"),
+])
+def test_the_cli_relabels_the_cores_refusal_with_the_scene_key(tmp_path, clearance, friction,
+                                                               message):
+    from conftest import run_in_process
+
+    scene = tmp_path / "s.toml"
+    scene.write_text(SCENE.format(clearance=clearance, friction=friction))
+    status, err = run_in_process("run", scene, "--out", tmp_path / "out")
+    assert status == 2
+    assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out" / "results.json").exists()
+
+
+# --- the deprecated name form: a warning and the same system -----------------------------------
+
+def _train(clearances, contact_kw=None):
+    from crankmodal.dynamics.model.mechanisms import Cylinder, crank_train
+
+    cyl = Cylinder(axis_angle=0.0, rod_length=0.14, rod_mass=0.9, rod_inertia=3e-3,
+                   rod_com=0.04, piston_mass=1.2)
+    return crank_train(0.035, [cyl], 3000.0, crank_inertia=0.05, clearances=clearances,
+                       contact_kw=contact_kw)
+
+
+def test_the_name_form_warns_and_builds_the_same_kernel_tables():
+    import numpy as np
+
+    from crankmodal.dynamics.kernel.compiled import CompiledSystem
+
+    law = {"stiffness": 3e10, "exponent": 1.4, "damping": 450.0, "penetration": 5e-5}
+    fr = {"mu_static": 0.2, "mu_dynamic": 0.15, "v_static": 1e-4, "v_dynamic": 1e-2}
+    geometry = {"clearance": 1e-4, "journal_radius": 0.02}
+    with pytest.warns(DeprecationWarning, match="deprecated"):
+        by_name = _train({"big_end_1": geometry},
+                         {"law": "impact", "law_params": law, "friction": "coulomb",
+                          "friction_params": fr})
+    typed = {"big_end_1": ClearanceSpec(**geometry, normal=Impact(**law), friction=Coulomb(**fr))}
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        by_object = _train(typed)
+    a, b = CompiledSystem(by_name.system), CompiledSystem(by_object.system)
+    # the tables hold the same input numbers copied (no arithmetic on them): equal exactly
+    assert np.array_equal(a.I, b.I) and np.array_equal(a.io, b.io)
+    assert np.array_equal(a.F, b.F) and np.array_equal(a.fo, b.fo)
+    assert by_name.system.clearances[0].law == Impact(**law)

@@ -495,6 +495,17 @@ class FrictionLaw:
         raise NotImplementedError
 
 
+def _transition(law) -> None:
+    """Check (and set as floats) ``v_static < v_dynamic``, both > 0 (m/s)."""
+    from ...errors import ParameterError
+
+    for k in ("v_static", "v_dynamic"):
+        object.__setattr__(law, k, _positive(k, getattr(law, k)))
+    if law.v_dynamic <= law.v_static:
+        raise ParameterError("v_dynamic", f"must be > v_static ({law.v_static:g} m/s), got "
+                             f"{law.v_dynamic:g}")
+
+
 @dataclass(frozen=True)
 class NoFriction(FrictionLaw):
     """Frictionless contact."""
@@ -526,8 +537,7 @@ class Coulomb(FrictionLaw):
     def __post_init__(self):
         for k in ("mu_static", "mu_dynamic"):
             object.__setattr__(self, k, _non_negative(k, getattr(self, k)))
-        for k in ("v_static", "v_dynamic"):
-            object.__setattr__(self, k, _positive(k, getattr(self, k)))
+        _transition(self)
 
     def coefficient(self, v):
         return contact.coulomb_coefficient(v, self.mu_static, self.mu_dynamic, self.v_static,
@@ -550,8 +560,7 @@ class Ambrosio(FrictionLaw):
 
     def __post_init__(self):
         object.__setattr__(self, "mu_dynamic", _non_negative("mu_dynamic", self.mu_dynamic))
-        for k in ("v_static", "v_dynamic"):
-            object.__setattr__(self, k, _positive(k, getattr(self, k)))
+        _transition(self)
 
     def coefficient(self, v):
         return contact.ambrosio_coefficient(v, self.mu_dynamic, self.v_static, self.v_dynamic)
@@ -596,3 +605,78 @@ def make_friction(name: str, params=None) -> FrictionLaw:
     0.1
     """
     return _build(FRICTION, "friction", name, params)
+
+
+def legacy_laws(law, law_params=None, friction=None, friction_params=None,
+                stacklevel: int = 3) -> tuple[NormalLaw, FrictionLaw]:
+    """The law objects of the deprecated name form ``law="impact", law_params={...}``.
+
+    The one place where law names and parameter dictionaries of the Python API become objects
+    (a scene's are made by its stage). Law objects pass through unchanged; a name or a
+    parameter dictionary issues a :class:`DeprecationWarning` (pass ``make_law(name, params)``
+    or the law's class instead).
+
+    Parameters
+    ----------
+    law : NormalLaw or str
+        The normal law, or its name (with ``law_params``).
+    law_params : mapping or None
+        Parameters of a normal law given by name (SI: ``stiffness`` N/m**exponent, ...).
+    friction : FrictionLaw, str or None
+        The friction law, or its name (with ``friction_params``); None: no friction.
+    friction_params : mapping or None
+        ``mu_static``, ``mu_dynamic`` (-), ``v_static``, ``v_dynamic`` (m/s) of a friction law
+        given by name.
+    stacklevel : int
+        Of the warning (2 points at the caller of this function).
+
+    Returns
+    -------
+    (NormalLaw, FrictionLaw)
+
+    Raises
+    ------
+    ParameterError
+        Naming ``law`` (neither a law nor a name), the unknown name's argument, or the law
+        parameter that is missing or invalid (``stiffness``, ``restitution``, ...).
+    """
+    import warnings
+
+    from ...errors import ParameterError
+
+    named = []
+    if isinstance(law, str):
+        named.append(f"law={law!r}, law_params={{...}}")
+        try:
+            law = make_law(law, law_params)
+        except ParameterError as exc:
+            raise ParameterError("law" if exc.argument == "name" else exc.argument,
+                                 exc.text) from None
+    elif law_params:
+        raise ParameterError("law_params", "goes with a law given by name; a law object "
+                             "carries its own parameters")
+    if not isinstance(law, NormalLaw):
+        raise ParameterError("law", f"must be a NormalLaw (e.g. Impact(...), or make_law(name, "
+                             f"params)), got {type(law).__name__} {law!r:.60}")
+    if friction is None:
+        friction = "none" if friction_params else NoFriction()
+    if isinstance(friction, str):
+        named.append(f"friction={friction!r}, friction_params={{...}}")
+        try:
+            friction = make_friction(friction, friction_params)
+        except ParameterError as exc:
+            raise ParameterError("friction" if exc.argument == "name" else exc.argument,
+                                 exc.text) from None
+    elif friction_params:
+        raise ParameterError("friction_params", "goes with a friction law given by name; a "
+                             "law object carries its own parameters")
+    if not isinstance(friction, FrictionLaw):
+        raise ParameterError("friction", f"must be a FrictionLaw (e.g. Coulomb(...), "
+                             f"NoFriction(), or make_friction(name, params)), got "
+                             f"{type(friction).__name__} {friction!r:.60}")
+    if named:
+        warnings.warn(f"{' and '.join(named)} is deprecated: pass the law objects "
+                      f"(law={type(law).__name__}(...), make_law(name, params))",
+                      DeprecationWarning, stacklevel=stacklevel)
+    return law, friction
+

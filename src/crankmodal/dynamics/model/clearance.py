@@ -143,19 +143,17 @@ class ClearanceJoint:
         Radial clearance ``c = R_bearing - R_journal``, m.
     journal_radius : float
         m (lever arm of friction).
-    law : NormalLaw or str
-        Normal force law: an object of :mod:`.laws`, or its name (one of
-        :data:`contact.NORMAL_LAWS`) with ``law_params``. After construction ``law`` is the
-        name and ``normal`` the law object.
-    law_params : dict
-        Parameters of a law given by name (see :func:`.laws.make_law`); with a law object, set
-        from it.
-    friction : FrictionLaw or str
-        Friction law: an object of :mod:`.laws`, or its name (one of
-        :data:`contact.FRICTION_LAWS`) with ``friction_params``. After construction
-        ``friction`` is the name and ``friction_law`` the object.
-    friction_params : dict
-        ``mu_static, mu_dynamic, v_static, v_dynamic`` (m/s) of a law given by name.
+    law : NormalLaw
+        Normal force law, an object of :mod:`..laws.objects` (``Impact(...)``,
+        ``make_law(name, params)``). Deprecated: its name with ``law_params``.
+    law_params : dict, optional
+        Deprecated: the parameters of a law given by name (None after construction).
+    friction : FrictionLaw
+        Friction law, an object of :mod:`..laws.objects` (default: none). Deprecated: its name
+        with ``friction_params``.
+    friction_params : dict, optional
+        Deprecated: ``mu_static, mu_dynamic, v_static, v_dynamic`` (m/s) of a law given by name
+        (None after construction).
     v_impact_min : float
         Floor of the impact velocity used by restitution laws, m/s: a contact that starts at
         (almost) zero approach speed would otherwise get unbounded damping.
@@ -185,10 +183,10 @@ class ClearanceJoint:
     bearing_frame: str
     clearance: float
     journal_radius: float
-    law: str | laws.NormalLaw = "impact"
-    law_params: dict = field(default_factory=dict)
-    friction: str | laws.FrictionLaw = "none"
-    friction_params: dict = field(default_factory=dict)
+    law: laws.NormalLaw = None
+    law_params: dict | None = field(default=None, repr=False)
+    friction: laws.FrictionLaw = laws.NoFriction()
+    friction_params: dict | None = field(default=None, repr=False)
     v_impact_min: float = 1e-3
     clearance_major: float | None = None
     wear_angle: float = 0.0
@@ -199,12 +197,20 @@ class ClearanceJoint:
     # impact velocity of the current contact (restitution laws) for callers that do not pass
     # one: the integrator keeps its own (simulate.integrate) and passes it to forces
     v_impact: float = 1e-3
-    normal: laws.NormalLaw = field(init=False, repr=False)
-    friction_law: laws.FrictionLaw = field(init=False, repr=False)
+
+    @property
+    def normal(self) -> laws.NormalLaw:
+        """The normal force law (:attr:`law`)."""
+        return self.law
+
+    @property
+    def friction_law(self) -> laws.FrictionLaw:
+        """The friction law (:attr:`friction`)."""
+        return self.friction
 
     @property
     def needs_memory(self) -> bool:
-        return self.normal.needs_impact_velocity
+        return self.law.needs_impact_velocity
 
     def kinematics(self, sysm, q, qd):
         """Eccentricity, penetration, penetration rate, slip velocity, and the frame data."""
@@ -240,17 +246,17 @@ class ClearanceJoint:
 
     def __post_init__(self):
         if self.film_model not in FILM_MODELS:
-            raise ValueError(f"film_model must be one of {FILM_MODELS}; got {self.film_model!r}")
-        if isinstance(self.law, laws.NormalLaw):
-            self.normal = self.law
-            self.law, self.law_params = self.normal.name, self.normal.params()
-        else:
-            self.normal = laws.make_law(self.law, self.law_params)
-        if isinstance(self.friction, laws.FrictionLaw):
-            self.friction_law = self.friction
-            self.friction, self.friction_params = self.friction_law.name, self.friction_law.params()
-        else:
-            self.friction_law = laws.make_friction(self.friction, self.friction_params)
+            raise ParameterError("film_model", f"must be one of {', '.join(FILM_MODELS)}; got "
+                                 f"{self.film_model!r}")
+        if self.law is None:
+            raise ParameterError("law", "is required: a NormalLaw (e.g. Impact(...), or "
+                                 "make_law(name, params))")
+        if not (isinstance(self.law, laws.NormalLaw) and isinstance(self.friction,
+                                                                      laws.FrictionLaw)
+                and self.law_params is None and self.friction_params is None):
+            self.law, self.friction = laws.legacy_laws(self.law, self.law_params, self.friction,
+                                                       self.friction_params, stacklevel=4)
+            self.law_params = self.friction_params = None
 
     def film_force(self, k) -> np.ndarray:
         """Film force on the journal (global x, y), N (``film_model``: short or finite)."""
@@ -283,11 +289,11 @@ class ClearanceJoint:
         k = self.kinematics(sysm, q, qd)
         delta, ddot = k["delta"], k["delta_dot"]
         if delta > 0.0:
-            law = self.normal
+            law = self.law
             v = self.v_impact if v_impact is None else v_impact
             fn = float(law.force(delta, ddot, max(v, self.v_impact_min)))
             fel = float(law.elastic_force(delta))
-            mu = float(self.friction_law.coefficient(k["v_slip"]))
+            mu = float(self.friction.coefficient(k["v_slip"]))
         else:
             fn = fel = mu = 0.0
         ft = -mu * fn
@@ -306,7 +312,7 @@ class ClearanceJoint:
                                  np.array([-f[0], -f[1], -k["r_b"] * ft - fn * k["dtheta"]]))
         k.update(fn=fn, ft=ft, force=f, film=float(np.hypot(*f_film)),
                  p_damp=(fn - fel) * ddot - p_film, p_fric=-ft * k["v_slip"],
-                 v_elastic=float(self.normal.elastic_energy(delta)))
+                 v_elastic=float(self.law.elastic_energy(delta)))
         return k
 
 

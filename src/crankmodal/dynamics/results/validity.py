@@ -46,14 +46,14 @@ def penetration_warning(cj, depth: float, force: float, E: float = 2.1e11,
         return None
     from ...report.quantity import number, quantity  # 92.3 µm, not 9.23e-05 m (issue 25 #15)
 
-    K = cj.law_params.get("stiffness", float("nan"))  # echoed as a scene value is typed
+    K = getattr(cj.law, "stiffness", float("nan"))  # echoed as a scene value is typed
     return (f"dynamics: joint {cj.name!r} penetrates {quantity(depth, 'm', 3)}, "
             f"{100 * of_clearance:.0f} % of its {quantity(cj.clearance, 'm', 3)} clearance "
             f"(warning above {100 * CLEARANCE_FRACTION:.0f} %) and {number(ratio, 2)} times the "
             f"elastic approach of journal and bore under its peak contact force "
             f"{quantity(force, 'N', 3)} ({quantity(approach, 'm', 2)}, Johnson's conformal "
             f"cylinders, L = {quantity(L, 'm', 3)}; warning above "
-            f"{APPROACH_FACTOR:g} times): the contact law ({cj.law}) is far outside its "
+            f"{APPROACH_FACTOR:g} times): the contact law ({cj.law.name}) is far outside its "
             f"validity; raise dynamics.contact.stiffness (now {K:.3g}) or use "
             f"dynamics.contact.law = 'johnson_cylinder'")
 

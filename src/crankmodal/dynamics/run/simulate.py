@@ -161,7 +161,8 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
         if depth > 0.1 * cj.journal_radius:
             raise NumericalError(
                 f"clearance joint {cj.name!r}: penetration {depth:.3g} m exceeds 10 % of the "
-                f"journal radius: contact.stiffness = {cj.law_params.get('stiffness'):.3g} is "
+                f"journal radius: contact.stiffness = "
+                f"{getattr(cj.law, 'stiffness', float('nan')):.3g} is "
                 "too low for these loads; raise it")
     err = hist.energy_error()
     if energy_tolerance is not None and err > energy_tolerance:

@@ -157,7 +157,7 @@ def joint_time_scales(mech, low_load: bool = False) -> list[TimeScale]:
         if not np.isfinite(m):
             continue
         load = max(0.0 if low_load else gas, m * omega**2 * r, 1.0)
-        law = cj.normal
+        law = cj.law
         with np.errstate(all="ignore"):  # extreme exponents/stiffnesses: no estimate, no error
             k = float(np.float64(law.tangent_stiffness(np.float64(load))))
             c = float(np.float64(law.dashpot(np.float64(load))))

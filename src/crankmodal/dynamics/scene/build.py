@@ -2,47 +2,103 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from ...errors import SceneError
+from ...errors import SceneError, scene_keys
 from ..laws import contact
+from ..laws.objects import FrictionLaw, NormalLaw, make_friction, make_law
+from ..model.clearance import ClearanceSpec
 from ..model.loads import tabulated_gas_force
 from ..model.mechanisms import Cylinder, crank_train, four_bar
 from ..run.integrate import SolverSettings, auto_method
 from .keys import cylinder_angles
 
+#: law parameter (argument of :mod:`..laws.objects`) -> its ``[dynamics.contact]`` key
+NORMAL_LAW_KEYS = {"stiffness": "stiffness", "exponent": "exponent", "damping": "damping",
+                   "penetration": "penetration", "restitution": "restitution",
+                   "radial_clearance": "stiffness", "law": "law"}
+#: :class:`ClearanceSpec` field -> its ``[[dynamics.clearances]]`` key
+CLEARANCE_KEYS = {"wear_angle": "wear_angle_deg", "normal": "law", "friction": "law",
+                  "v_impact_min": "v_impact_min"}
 
-def contact_arguments(p) -> tuple[dict, dict]:
-    """Shared clearance-joint keywords and per-joint specs from the parameters."""
-    c, f = p["contact"], p["friction"]
-    law_params = {"exponent": c["exponent"], "damping": c["damping"],
-                  "penetration": c["penetration"], "restitution": c["restitution"]}
-    if c["stiffness"] is not None:
-        law_params["stiffness"] = c["stiffness"]
-    kw = {"law": c["law"], "law_params": law_params, "friction": f["law"],
-          "friction_params": {k: f[k] for k in ("mu_static", "mu_dynamic", "v_static",
-                                                "v_dynamic")},
-          "v_impact_min": c["v_impact_min"]}
+
+def friction_law(p) -> FrictionLaw:
+    """The ``[dynamics.friction]`` law object (law errors relabelled with its keys)."""
+    f = p["friction"]
+    with scene_keys("dynamics.friction", {"name": "law"}):
+        return make_friction(f["law"], {k: f[k] for k in ("mu_static", "mu_dynamic",
+                                                          "v_static", "v_dynamic")})
+
+
+def normal_law(p, clearance: dict) -> NormalLaw:
+    """The ``[dynamics.contact]`` law object of one ``[[dynamics.clearances]]`` entry: its
+    stiffness, when not given, from E, nu and the radii (Hertz constant, N/m^1.5) or, for
+    ``johnson_cylinder``, pi L E* (N/m) with the joint's clearance as ``radial_clearance``."""
+    c = p["contact"]
+    params = {"exponent": c["exponent"], "damping": c["damping"],
+              "penetration": c["penetration"], "restitution": c["restitution"],
+              "stiffness": c["stiffness"]}
+    if c["law"] == "johnson_cylinder":  # a line contact: its own stiffness pi L E*, and dR
+        if params["stiffness"] is None:
+            params["stiffness"] = float(np.pi * clearance["bearing_length"] * contact.
+                                        effective_modulus(c["E"], c["nu"], c["E"], c["nu"]))
+        params["radial_clearance"] = clearance["clearance"]
+    elif params["stiffness"] is None:
+        rj = clearance["journal_radius"]
+        params["stiffness"] = float(contact.cylinder_stiffness(
+            rj, rj + clearance["clearance"], c["E"], c["nu"], c["E"], c["nu"]))
+    with scene_keys("dynamics.contact", NORMAL_LAW_KEYS | {"name": "law"}):
+        return make_law(c["law"], params)
+
+
+def clearance_specs(p) -> dict[str, ClearanceSpec]:
+    """``{joint: ClearanceSpec}`` of the ``[[dynamics.clearances]]`` entries: the typed
+    description the mechanism builders take, made once here (errors name the scene keys)."""
+    friction = friction_law(p)
     specs = {}
-    for cl in p["clearances"]:
-        spec = {"clearance": cl["clearance"], "journal_radius": cl["journal_radius"],
-                "clearance_major": cl["clearance_major"],
-                "wear_angle": float(np.deg2rad(cl["wear_angle_deg"])),
-                "viscosity": cl["viscosity"], "bearing_length": cl["bearing_length"] or 0.0,
-                "film_model": cl["film_model"]}
-        if c["law"] == "johnson_cylinder":  # a line contact: its own stiffness pi L E*, and dR
-            K = c["stiffness"]
-            if K is None:
-                K = np.pi * cl["bearing_length"] * contact.effective_modulus(c["E"], c["nu"],
-                                                                             c["E"], c["nu"])
-            spec["contact"] = {"law_params": dict(law_params, stiffness=float(K),
-                                                  radial_clearance=cl["clearance"])}
-        elif c["stiffness"] is None:
-            rj = cl["journal_radius"]
-            K = contact.cylinder_stiffness(rj, rj + cl["clearance"], c["E"], c["nu"], c["E"], c["nu"])
-            spec["contact"] = {"law_params": dict(law_params, stiffness=float(K))}
-        specs[cl["joint"]] = spec
-    return kw, specs
+    for i, cl in enumerate(p["clearances"]):
+        with scene_keys(f"dynamics.clearances[{i}]", CLEARANCE_KEYS):
+            specs[cl["joint"]] = ClearanceSpec(
+                clearance=cl["clearance"], journal_radius=cl["journal_radius"],
+                normal=normal_law(p, cl), friction=friction,
+                v_impact_min=p["contact"]["v_impact_min"],
+                clearance_major=cl["clearance_major"],
+                wear_angle=float(np.deg2rad(cl["wear_angle_deg"])), viscosity=cl["viscosity"],
+                bearing_length=cl["bearing_length"], film_model=cl["film_model"])
+    return specs
+
+
+@dataclass(frozen=True)
+class Drive:
+    """How the crank is driven, as the builders take it.
+
+    Parameters
+    ----------
+    speed_rpm : float
+        Prescribed (or, with ``drive_torque``, initial) crank speed, rpm.
+    theta0 : float
+        Initial crank angle, rad.
+    ramp_time : float
+        Speed ramp from rest, s (0: full speed at once).
+    drive_torque : float or None
+        Constant driving torque, N m (the speed free), or None (speed prescribed).
+    direction : int
+        1 counter-clockwise, -1 clockwise.
+    """
+
+    speed_rpm: float
+    theta0: float
+    ramp_time: float
+    drive_torque: float | None
+    direction: int
+
+    def arguments(self) -> dict:
+        """The keyword arguments of :func:`~..model.mechanisms.crank_train` and ``four_bar``."""
+        return {"speed_rpm": self.speed_rpm, "theta0": self.theta0,
+                "ramp_time": self.ramp_time, "drive_torque": self.drive_torque,
+                "direction": self.direction}
 
 
 #: shortest admissible time constant m v_f / F of a piston's smoothed ring friction, s: below it
@@ -77,26 +133,28 @@ def build_mechanism(p, mechanism_params=None, bodies=None):
     bodies = bodies or {}
     crank, roles = bodies.get("crank") or (None, None)
     body_kw = {"crank_body": crank, "crank_roles": roles, "rod_bodies": bodies.get("rods")}
-    kw, specs = contact_arguments(p)
+    specs = clearance_specs(p)
     gas = None
     if p["gas_force_deg"] is not None:
         gas = tabulated_gas_force(p["gas_force_deg"], p["gas_force_n"], p["gas_cycle_deg"])
     direction = -1 if p["rotation"] == "cw" else 1
     ct = p["crank_train"]
-    if p["from_mechanism"]:
-        from ..model.bridge import cylinders_from_mechanism
+    from .trains import machine_cylinders, train_arguments
 
-        src = cylinders_from_mechanism(mechanism_params, p["ring_friction_n"])
+    body_kw.update(train_arguments(p, crank is not None))
+    if p["from_mechanism"]:
+        src = machine_cylinders(p, mechanism_params)  # each cylinder on its throw
+        body_kw["arrangement"] = src["arrangement"]
         check_ring_friction(p["ring_friction_n"], src["cylinders"])
         speed = p["speed_rpm"] or src["speed_rpm"]
-        common = _common(p, speed, specs, kw, src["direction"])
+        common = _common(p, speed, specs, src["direction"])
         # the mechanism's unbalance at the pin, less a counterweight opposite it (both kg m)
         mr = src["crank_unbalance"] - ct["counterweight_mass_radius"]
         com = mr / ct["crank_mass"] if ct["crank_mass"] > 0 else 0.0
         return crank_train(src["crank_radius"], src["cylinders"], crank_mass=ct["crank_mass"],
                            crank_inertia=ct["crank_inertia"], crank_com=com, kind=p["mechanism"],
                            **common, **body_kw)
-    common = _common(p, p["speed_rpm"], specs, kw, direction)
+    common = _common(p, p["speed_rpm"], specs, direction)
     if p["mechanism"] == "four_bar":
         fb = p["four_bar"]
         return four_bar(*fb["lengths"], rocker_pivot=fb["rocker_pivot"], masses=fb["masses"],
@@ -121,11 +179,11 @@ def build_mechanism(p, mechanism_params=None, bodies=None):
                        kind=p["mechanism"], **common, **body_kw)
 
 
-def _common(p, speed_rpm, specs, kw, direction):
-    return {"speed_rpm": speed_rpm, "theta0": np.deg2rad(p["initial_angle_deg"]),
-            "ramp_time": p["ramp_time"], "drive_torque": p["drive_torque"], "clearances": specs,
-            "contact_kw": kw, "gravity": tuple(p["gravity"]),
-            "baumgarte": p["solver"]["baumgarte"], "direction": direction}
+def _common(p, speed_rpm, specs, direction):
+    drive = Drive(speed_rpm=speed_rpm, theta0=float(np.deg2rad(p["initial_angle_deg"])),
+                  ramp_time=p["ramp_time"], drive_torque=p["drive_torque"], direction=direction)
+    return {**drive.arguments(), "clearances": specs,
+            "gravity": tuple(p["gravity"]), "baumgarte": p["solver"]["baumgarte"]}
 
 
 def solver_settings(p, speed_rpm, flexible: bool = False) -> SolverSettings:
@@ -137,8 +195,8 @@ def solver_settings(p, speed_rpm, flexible: bool = False) -> SolverSettings:
     omega = speed_rpm * 2 * np.pi / 60
     method = s["method"]
     if method == "auto":  # the API's simulate decides with the same function
-        fr = p["friction"]
-        method = auto_method([(c["journal_radius"], fr["law"], fr["v_dynamic"],
+        fr = friction_law(p)
+        method = auto_method([(c["journal_radius"], fr.name, float(getattr(fr, "v_dynamic", 0.0)),
                                c["viscosity"] is not None) for c in p["clearances"]],
                              omega, flexible)
     return SolverSettings(method=method, rtol=s["rtol"], atol=atol,

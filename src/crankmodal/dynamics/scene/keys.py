@@ -280,6 +280,9 @@ def validate_section(raw: dict) -> dict:
     p["solver"] = validate("dynamics.solver", p["solver"], SOLVER)
     p["flexible"] = validate_flexible(p["flexible"], p["mechanism"])
     _cross_checks(p)
+    from .build import clearance_specs
+
+    clearance_specs(p)  # the law objects and clearance specs refuse what the core refuses
     if p["mechanism"] == "four_bar":  # a bar reduced here: its size refused before it is meshed
         from ..flexible.build import check_bar
 
@@ -343,15 +346,6 @@ def _cross_checks(p):
         if c["joint"] not in names:
             raise SceneError(f"dynamics.clearances[{i}].joint: must be one of {', '.join(names)}; "
                              f"got {c['joint']!r}")
-        if c["clearance_major"] is not None and c["clearance_major"] < c["clearance"]:
-            raise SceneError(f"dynamics.clearances[{i}].clearance_major: must be >= clearance "
-                             f"({c['clearance']:g} m)")
-        if c["viscosity"] is not None and c["bearing_length"] is None:
-            raise SceneError(f"dynamics.clearances[{i}].bearing_length: is required with "
-                             "viscosity (bearing length, m, > 0)")
-        if c["viscosity"] is not None and c["clearance_major"] is not None:
-            raise SceneError(f"dynamics.clearances[{i}].viscosity: the film model needs a round "
-                             "bore; remove clearance_major or viscosity")
         if p["contact"]["law"] == "johnson_cylinder" and c["bearing_length"] is None:
             raise SceneError(f"dynamics.clearances[{i}].bearing_length: is required with "
                              "contact.law = 'johnson_cylinder' (bearing length, m, > 0)")
@@ -381,10 +375,6 @@ def _cross_checks(p):
             raise SceneError("dynamics.gas_force_n: needs as many entries as gas_force_deg (>= 2)")
         if np.any(np.diff(g) <= 0) or g[0] < 0 or g[-1] > p["gas_cycle_deg"]:
             raise SceneError("dynamics.gas_force_deg: must increase within [0, gas_cycle_deg]")
-    fr = p["friction"]
-    if fr["law"] != "none" and fr["v_dynamic"] <= fr["v_static"]:
-        raise SceneError("dynamics.friction.v_dynamic: must be > v_static "
-                         f"({fr['v_static']:g} m/s)")
     if ct["counterweight_mass_radius"] > 0 and p["mechanism"] != "four_bar" \
             and ct["crank_mass"] <= 0:
         raise SceneError("dynamics.crank_train.counterweight_mass_radius: needs crank_mass > 0 "
