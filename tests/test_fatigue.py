@@ -262,3 +262,24 @@ def test_out_of_phase_bending_and_torsion_is_flagged_non_proportional(oracle):
                               np.zeros((1, 3)))
     assert inphase.proportionality[0] == pytest.approx(1.0, rel=1e-12)
     assert not inphase.warnings
+
+
+def test_material_scene_keys_carry_fatigue_data_and_refuse_bad_values():
+    from pathlib import Path
+
+    from crankmodal.errors import SceneError
+    from crankmodal.fem import material_stage
+    from crankmodal.scene import Scene
+
+    scene = Scene(name="t", base_dir=Path("."))
+    p = material_stage.validate({"name": "steel", "fatigue_strength": 250e6}, scene)
+    m = material_stage.make_material(p)
+    assert m.fatigue_strength == 250e6 and m.torsional_fatigue_strength == pytest.approx(
+        250e6 / math.sqrt(3))
+    with pytest.raises(SceneError, match=r"^material\.fatigue_strength: "):
+        material_stage.validate({"name": "steel", "fatigue_strength": -1.0}, scene)
+    custom = material_stage.make_material(material_stage.validate(
+        {"E": 2e11, "nu": 0.3, "rho": 7800.0, "ultimate_strength": 6e8}, scene))
+    with pytest.raises(ParameterError) as exc:  # the verdict names the missing key
+        fatigue_verdict(np.ones((1, 6, 1)), np.sin(CYCLE)[None, :], custom, np.zeros((1, 3)))
+    assert exc.value.argument == "fatigue_strength"

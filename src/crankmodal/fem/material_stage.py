@@ -20,6 +20,11 @@ SCHEMA: dict[str, Field] = {
     "rho": Field("float", None, "density, kg/m^3", gt=0.0),
     "yield_strength": Field("float", None, "yield (0.2 % proof) strength, Pa", gt=0.0),
     "ultimate_strength": Field("float", None, "ultimate tensile strength, Pa", gt=0.0),
+    "fatigue_strength": Field("float", None, "fully reversed fatigue strength of unnotched "
+                              "specimens, Pa (the crankshaft fatigue verdict needs it)", gt=0.0),
+    "fatigue_strength_torsion": Field("float", None, "fully reversed torsional fatigue strength, "
+                                      "Pa (default fatigue_strength / sqrt(3))", gt=0.0),
+    "fatigue_cycles": Field("float", None, "cycles at which the fatigue strengths hold", ge=1.0),
 }
 
 
@@ -44,7 +49,8 @@ def make_material(p: dict):
 
     from .materials import Material, material
 
-    over = {k: p[k] for k in ("E", "nu", "rho", "yield_strength", "ultimate_strength")
+    over = {k: p[k] for k in ("E", "nu", "rho", "yield_strength", "ultimate_strength",
+                              "fatigue_strength", "fatigue_strength_torsion", "fatigue_cycles")
             if p.get(k) is not None}
     with scene_keys(SECTION):  # the Material's own checks, named by their scene keys
         if p.get("name"):
