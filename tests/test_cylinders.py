@@ -75,22 +75,22 @@ def test_the_scene_bridge_builds_the_machine_cylinders_with_their_gas_forces():
         (m.crank_radius, -1, m.speed_rpm)
 
 
-def test_the_scene_bridge_refuses_a_cylinder_on_its_own_throw_under_the_scene_key():
-    """A scene user reads the stage's message (SceneError, dynamics.from_mechanism), not the
-    core's ParameterError."""
-    from crankmodal.errors import SceneError
+def test_the_scene_bridge_puts_a_cylinder_on_its_own_throw_by_the_machines_arrangement():
+    """Multi-throw trains (issue 29): a cylinder at another throw angle gets its own throw
+    (it was refused before); the arrangement is the forced torsion's
+    (arrangement_of_machine), so both stages read one description."""
+    from crankmodal.mechanism.arrangement import arrangement_of_machine
 
     mp = _four_star_params()
     mp["cylinders"][2]["throw_angle_deg"] = 90.0
-    with pytest.raises(SceneError) as err:
-        cylinders_from_mechanism(mp)
-    assert not isinstance(err.value, ParameterError)
-    assert str(err.value) == ("dynamics.from_mechanism: cylinders on separate crank throws are "
-                              "not supported yet (throw_angle_deg must be 0)")
+    src = cylinders_from_mechanism(mp)
+    m = mm.machine_from_params(mp)
+    assert src["arrangement"] == arrangement_of_machine(m)  # one throw per cylinder
+    assert src["arrangement"].cylinder_throw_angles()[2] == pytest.approx(math.pi / 2)
 
 
-def test_from_machine_refuses_a_cylinder_on_its_own_throw_naming_the_field():
+def test_from_machine_takes_a_cylinder_on_its_own_throw_the_throw_is_the_arrangements():
     rod = mm.Rod(length=0.28, mass=0.9, cg_from_big_end=0.07, inertia=0.0123)
     cyl = mm.Cylinder(0.0, 0.0, math.radians(90.0), 1.7, 0.1)
-    with pytest.raises(ParameterError, match=r"^cylinder.throw_angle: cylinders on separate "):
-        Cylinder.from_machine(mm.Machine("m", 0.06, rod, 1480.0, (cyl,)), cyl)
+    built = Cylinder.from_machine(mm.Machine("m", 0.06, rod, 1480.0, (cyl,)), cyl)
+    assert built.axis_angle == pytest.approx(math.pi / 2)

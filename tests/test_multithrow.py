@@ -111,3 +111,162 @@ def test_coupling_stiffness_and_motor_inertia_refused_naming_the_argument():
     with pytest.raises(ParameterError) as exc:
         crank_train(0.05, [_tiny_cylinder()], 600.0, motor=MotorDrive(0.1, 1e4))
     assert exc.value.argument == "crank_inertia"
+
+
+# ------------------------------------------------------------ superposition of slider-cranks
+R, L, MR, IR, A, MP = 0.06, 0.24, 6.0, 0.0768, 0.08, 20.194  # seed 004's compressor
+
+
+def _gas(psi):
+    """Gas force on a piston, N, towards the crank (a peaked compression cycle)."""
+    return 4.0e4 * np.cos(0.5 * psi) ** 8
+
+
+def _big_end_force(theta, omega, gamma, axis, direction):
+    """Force of the crank on the rod at the big end (global axes, N) of an ideal slider-crank
+    at constant speed, in closed form: the exact piston kinematics (s = p + sqrt(L^2 - h^2)
+    with p, h the pin's position along and across the axis, differentiated twice by hand)
+    and Newton-Euler of the piston (along the axis) and the rod (three equations)."""
+    u = np.asarray(axis, float)
+    n = np.array([-u[1], u[0]])
+    al = theta + direction * gamma
+    P = R * np.array([np.cos(al), np.sin(al)])
+    P1 = omega * R * np.array([-np.sin(al), np.cos(al)])
+    P2 = -omega ** 2 * P
+    h, h1, h2 = P @ n, P1 @ n, P2 @ n
+    p2 = P2 @ u
+    w = np.sqrt(L * L - h * h)
+    w2 = -(h1 * h1 + h * h2) / w - h * h * h1 * h1 / w ** 3
+    X, X2 = (P @ u + w) * u, (p2 + w2) * u
+    D, D2 = X - P, X2 - P2
+    G, G2 = P + (A / L) * D, P2 + (A / L) * D2
+    phi2 = (D[0] * D2[1] - D[1] * D2[0]) / L ** 2            # the rod's angular acceleration
+    psi = direction * (theta - (np.arctan2(u[1], u[0]) - direction * gamma))
+    f_u = -MP * (p2 + w2) - _gas(psi)                         # piston on rod, along the axis
+
+    def cross(a, b):
+        return a[0] * b[1] - a[1] * b[0]
+
+    rP, rX = P - G, X - G          # unknowns: crank on rod (x, y), piston on rod across the axis
+    M = np.array([[1.0, 0.0, n[0]], [0.0, 1.0, n[1]], [-rP[1], rP[0], cross(rX, n)]])
+    rhs = np.array([MR * G2[0] - f_u * u[0], MR * G2[1] - f_u * u[1],
+                    IR * phi2 - f_u * cross(rX, u)])
+    return np.linalg.solve(M, rhs)[:2]
+
+
+def test_two_throw_rigid_crank_on_two_journals_is_two_slider_cranks_superposed_by_the_lever():
+    d, speed, zs, jz = -1, 1500.0, (-0.05, 0.07), [-0.15, 0.15]
+    arrangement = Arrangement(throw_angles=(0.0, np.pi), cylinder_throws=(0, 1),
+                              bank_angles=(0.0, 0.0))
+    cyls = [Cylinder(axis_angle=np.pi / 2, rod_length=L, rod_mass=MR, rod_inertia=IR,
+                     rod_com=A, piston_mass=MP, z=z, gas_force=_gas) for z in zs]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")   # the typed API: no deprecation on the way
+        mech = crank_train(R, cyls, speed, direction=d, arrangement=arrangement,
+                           journals_z=jz, theta0=0.3, crank_inertia=1.0)
+    from crankmodal.dynamics.results.journals import journal_forces, journal_statistics
+
+    hist = simulate(mech, 1 / 25.0, 1 / 25.0 / 360,
+                    SolverSettings(method="DOP853", rtol=1e-10, atol=1e-12), ideal=True)
+    omega = d * speed * np.pi / 30.0
+    got = journal_forces(mech, hist)
+    expected = {"main_1": np.zeros((hist.t.size, 2)), "main_2": np.zeros((hist.t.size, 2))}
+    for k, theta in enumerate(hist.crank_angle):
+        for gamma, z in zip((0.0, np.pi), zs):
+            on_crank = -_big_end_force(theta, omega, gamma, (0.0, 1.0), d)
+            w1 = (jz[1] - z) / (jz[1] - jz[0])
+            expected["main_1"][k] += w1 * on_crank
+            expected["main_2"][k] += (1.0 - w1) * on_crank
+    for name, f in expected.items():
+        peak = np.max(np.hypot(f[:, 0], f[:, 1]))
+        # measured 1.4e-10 of the peaks (18.5 and 20.1 kN); the issue asks 1e-9
+        np.testing.assert_allclose(got[name], f, rtol=0, atol=1e-9 * peak)
+    np.testing.assert_allclose(got["main_1"] + got["main_2"], hist.main_bearing_force,
+                               rtol=0, atol=1e-9 * np.max(np.abs(hist.main_bearing_force)))
+    stats = journal_statistics(mech, hist, 0.0)
+    assert stats["main_1"]["share_mean"] + stats["main_2"]["share_mean"] == pytest.approx(1.0)
+
+
+# ---------------------------------------------------------------------------------- gas phasing
+def test_each_cylinders_gas_force_peaks_at_its_firing_angle_from_the_arrangement():
+    from crankmodal.dynamics.model.loads import PistonLoads, tabulated_gas_force
+
+    peak_after_tdc = 12.0   # deg after firing top dead centre
+    ang = np.arange(0.0, 720.0, 1.0)
+    gas = tabulated_gas_force(ang, 1e3 + 5e4 * np.exp(-0.5 * ((ang - peak_after_tdc) / 8.0) ** 2),
+                              720.0)
+    arrangement = Arrangement(throw_angles=(0.0, np.pi, np.pi, 0.0), cylinder_throws=(0, 1, 2, 3),
+                              bank_angles=(0.0,) * 4, cycle_revolutions=2,
+                              firing_order=(0, 2, 3, 1))
+    cyls = [Cylinder(axis_angle=np.pi / 2, rod_length=0.144, rod_mass=0.65, rod_inertia=0.0021,
+                     rod_com=0.04, piston_mass=0.7, z=z, gas_force=gas)
+            for z in (-0.1365, -0.0455, 0.0455, 0.1365)]
+    mech = crank_train(0.04775, cyls, 0.0, direction=-1, arrangement=arrangement)
+    sysm = mech.ideal
+    loads = [ld for ld in sysm.loads if isinstance(ld, PistonLoads)]
+    # the reference crank angle of the arrangement, theta_m = 90 deg - theta (clockwise)
+    theta_m = np.deg2rad(np.arange(0.0, 720.0, 0.25))
+    forces = np.zeros((theta_m.size, 4))
+    sl = [sysm.slices[id(p)] for p in mech.pistons]
+    for k, tm in enumerate(theta_m):
+        q = mech.q0.copy()
+        q[sysm.slices[id(mech.crank)].start + 2] = np.pi / 2 - tm
+        qd = np.zeros_like(q)  # the gas force depends on the crank angle alone
+        for i, ld in enumerate(loads):
+            Q = np.zeros(sysm.n)
+            ld.forces(sysm, 0.0, q, qd, Q)
+            forces[k, i] = -(Q[sl[i]][:2] @ mech.axes[i])  # towards the crank
+    fire = np.degrees(arrangement.firing_angles())      # 0, 540, 180, 360 for 1-3-4-2
+    np.testing.assert_allclose(fire, [0.0, 540.0, 180.0, 360.0], atol=1e-9)
+    for i in range(4):
+        at = np.degrees(theta_m[np.argmax(forces[:, i])])
+        assert at == pytest.approx((fire[i] + peak_after_tdc) % 720.0, abs=0.25)
+
+
+# ---------------------------------------------------------------------------------- bad input
+def test_bad_arrangements_are_refused_naming_the_argument():
+    with pytest.raises(ParameterError) as exc:
+        Arrangement(throw_angles=(0.0, np.pi), cylinder_throws=(0, 1), bank_angles=(0.0, 0.0),
+                    cycle_revolutions=2, firing_order=(0, 0))
+    assert exc.value.argument == "firing_order"
+    with pytest.raises(ParameterError) as exc:   # a cylinder on a throw the crank lacks
+        Arrangement(throw_angles=(0.0, np.pi), cylinder_throws=(0, 2), bank_angles=(0.0, 0.0))
+    assert exc.value.argument == "cylinder_throws[1]"
+    two = Arrangement(throw_angles=(0.0, np.pi), cylinder_throws=(0, 1), bank_angles=(0.0, 0.0))
+    cyl = Cylinder(axis_angle=np.pi / 2, rod_length=L, rod_mass=MR, rod_inertia=IR, rod_com=A,
+                   piston_mass=MP)
+    with pytest.raises(ParameterError) as exc:   # three cylinders, two placed
+        crank_train(R, [cyl] * 3, 600.0, arrangement=two)
+    assert exc.value.argument == "arrangement.cylinder_throws"
+    tilted = Cylinder(axis_angle=0.0, rod_length=L, rod_mass=MR, rod_inertia=IR, rod_com=A,
+                      piston_mass=MP)
+    with pytest.raises(ParameterError) as exc:   # an axis off its bank angle
+        crank_train(R, [cyl, tilted], 600.0, arrangement=two)
+    assert exc.value.argument == "cylinders[1].axis_angle"
+    with pytest.raises(ParameterError) as exc:   # a rigid crank on three journals
+        crank_train(R, [cyl, cyl], 600.0, arrangement=two, journals_z=[-0.2, 0.0, 0.2])
+    assert exc.value.argument == "journals_z"
+    with pytest.raises(ParameterError) as exc:
+        crank_train(R, [cyl], 600.0, arrangement="inline")
+    assert exc.value.argument == "arrangement"
+
+
+def test_dict_clearances_still_work_with_one_deprecation_warning_and_give_the_typed_joint():
+    from crankmodal.dynamics.laws.objects import Impact
+    from crankmodal.dynamics.model.clearance import ClearanceSpec
+
+    cyl = Cylinder(axis_angle=np.pi / 2, rod_length=L, rod_mass=MR, rod_inertia=IR, rod_com=A,
+                   piston_mass=MP)
+    law = {"stiffness": 1e10, "damping": 300.0, "penetration": 1e-4}
+    with pytest.warns(DeprecationWarning, match="ClearanceSpec") as rec:
+        old = crank_train(R, [cyl], 600.0, clearances={"big_end_1": {
+            "clearance": 1e-4, "journal_radius": 0.02}}, contact_kw={"law": "impact",
+                                                                     "law_params": law})
+    assert sum(issubclass(w.category, DeprecationWarning) for w in rec) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        new = crank_train(R, [cyl], 600.0, clearances={"big_end_1": ClearanceSpec(
+            1e-4, 0.02, Impact(**law))})
+    a, b = old.system.clearances[0], new.system.clearances[0]
+    assert (a.clearance, a.journal_radius, a.normal.vector().tolist()) == \
+        (b.clearance, b.journal_radius, b.normal.vector().tolist())

@@ -103,7 +103,9 @@ class Cylinder:
         machine : crankmodal.mechanism.machine.Machine
             Gives the rod (length m, mass kg, inertia kg m², centre of mass from the big end m).
         cylinder : crankmodal.mechanism.machine.Cylinder
-            One of ``machine.cylinders``; its crankpin must be the shared one (throw angle 0).
+            One of ``machine.cylinders``. Its throw angle is not kept here: the throws are
+            the arrangement's (:func:`crank_train`'s ``arrangement``,
+            :func:`~crankmodal.mechanism.arrangement.arrangement_of_machine`).
         gas_force : callable, optional
             Gas force on the piston against crank angle (see :mod:`crankmodal.dynamics.model.loads`).
         ring_friction : float
@@ -112,8 +114,7 @@ class Cylinder:
         Raises
         ------
         ParameterError
-            ``machine`` or ``cylinder`` of the wrong kind, or ``cylinder.throw_angle`` not 0
-            (:func:`crank_train` puts every rod on one pin).
+            ``machine`` or ``cylinder`` of the wrong kind.
         """
         for name, value, attrs in (("machine", machine, ("rod",)),
                                    ("cylinder", cylinder, ("throw_angle", "bank_angle",
@@ -122,9 +123,6 @@ class Cylinder:
                 raise ParameterError(name, f"must be a crankmodal.mechanism.machine "
                                      f"{'Machine' if name == 'machine' else 'Cylinder'} "
                                      f"(with {', '.join(attrs)}), got {value!r:.60}")
-        if abs(cylinder.throw_angle) > 0.0:
-            raise ParameterError("cylinder.throw_angle", "cylinders on separate crank throws are "
-                                 f"not supported yet (must be 0, got {cylinder.throw_angle})")
         rod = machine.rod
         return cls(axis_angle=np.pi / 2 - cylinder.bank_angle, rod_length=rod.length,
                    rod_mass=rod.mass, rod_inertia=rod.inertia, rod_com=rod.cg_from_big_end,
@@ -253,7 +251,7 @@ def _split(pins, clearances, contact_kw):
         raise ParameterError("clearances", f"must be a mapping {{joint: ClearanceSpec}}, got "
                              f"{specs!r:.60}")
     if contact_kw or any(not isinstance(v, ClearanceSpec) for v in dict(specs).values()):
-        specs = clearance_specs(specs, contact_kw, stacklevel=4)
+        specs = clearance_specs(specs, contact_kw, stacklevel=5)
     specs = arg.table("clearances", specs, {p.name for p in pins})
     ideal_pins, clear = [], []
     for p in pins:
@@ -643,9 +641,9 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
     reference = 0.0  # angle of the reference throw in the crank's body axes
     if crank_body is None:
         frames = {"main": (-b, 0.0)}
-        if layout.n_throws == 1 and layout.pin_angles[0] == 0.0:
+        if all(a == 0.0 for a in layout.pin_angles):  # one crankpin, as ever
             frames["pin"] = (r - b, 0.0)
-            throw_frames = ["pin"]
+            throw_frames = ["pin"] * layout.n_throws
         else:
             throw_frames = [f"pin_{t}" for t in range(1, layout.n_throws + 1)]
             for name, a in zip(throw_frames, layout.pin_angles):

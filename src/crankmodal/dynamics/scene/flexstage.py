@@ -37,6 +37,19 @@ def train_geometry(p, mechanism_params):
     return ct["crank_radius"], [ct["rod_length"]] * n, list(ct["row_z"] or [0.0] * n)
 
 
+def _machine_throws(p, mechanism_params):
+    """Per cylinder its 1-based throw when a ``[mechanism]`` machine has several throws (the
+    arrangement of :func:`~.trains.machine_cylinders`), else None."""
+    if not p["from_mechanism"]:
+        return None
+    from .trains import machine_cylinders
+
+    arrangement = machine_cylinders(p, mechanism_params)["arrangement"]
+    if len({round(float(a), 9) for a in arrangement.throw_angles}) <= 1:
+        return None
+    return [t + 1 for t in arrangement.cylinder_throws]
+
+
 def _file(spec, machine, part, n_rods, key):
     from ..flexible.build import reduced_part
 
@@ -132,8 +145,12 @@ def make_bodies(p, mechanism_params=None) -> dict | None:
     try:
         if flex["crank"] is not None:
             path = _file(flex["crank"], machine, "crankshaft", len(rows), "crank")
+            throws = _machine_throws(p, mechanism_params)
             with body_keys("crank"):
-                out["crank"] = crank_body(path, flex["crank"], rows, radius)
+                if throws is None:
+                    out["crank"] = crank_body(path, flex["crank"], rows, radius)
+                else:  # multi-throw: each rod on its throw's band (.trains, issue 29)
+                    out["crank"] = crank_body(path, flex["crank"], None, radius, throws=throws)
             out["files"]["crank"] = str(path)
         key = "rods"
         if flex["rods"] is not None:

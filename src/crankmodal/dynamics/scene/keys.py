@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -10,6 +11,7 @@ from ...errors import SceneError
 from ...schema import Field, validate
 from ..laws import contact
 from ..model.clearance import FILM_MODELS
+from .trains import TRAIN_KEYS, check_train_keys
 
 MECHANISMS = ("slider_crank", "four_star", "four_bar")
 METHODS = ("auto", "LSODA", "Radau", "BDF", "RK45", "DOP853")
@@ -82,6 +84,7 @@ CRANK_TRAIN = {
     "cylinder_angles_deg": Field("floats", None, "cylinder axis angles from x, deg (slider_crank "
                                  "[0], four_star [90, 270, 0, 180])"),
     "row_z": Field("floats", None, "axial row position of each rod on the crankpin, m"),
+    **TRAIN_KEYS,  # multi-throw trains: arrangement, journals, motor (.trains)
 }
 
 FOUR_BAR = {
@@ -340,10 +343,15 @@ def _cross_checks(p):
         if not (s[0] + s[3] <= s[1] + s[2] and min(s) == l1):
             raise SceneError("dynamics.four_bar.lengths: not a crank-rocker (Grashof with the "
                              "crank shortest) for the given rocker_pivot")
+    check_train_keys(p)
     names = joint_names(p)
     seen = set()
     for i, c in enumerate(p["clearances"]):
-        if c["joint"] not in names:
+        # main_1..N: a flexible crank's journals; any cylinder's joints of a [mechanism]
+        # machine (crank_train refuses names its train does not have, under this key)
+        multi = re.fullmatch(r"main_\d+", c["joint"]) or (
+            p["from_mechanism"] and re.fullmatch(r"(big|small)_end_\d+", c["joint"]))
+        if c["joint"] not in names and not multi:
             raise SceneError(f"dynamics.clearances[{i}].joint: must be one of {', '.join(names)}; "
                              f"got {c['joint']!r}")
         if p["contact"]["law"] == "johnson_cylinder" and c["bearing_length"] is None:

@@ -181,6 +181,9 @@ def run(params: dict, ctx) -> dict:
     res = _run_numbers(model, runs.hist, sel, n_rev)
     res["warnings"] = model.warnings
     res["clearance_joints"] = _joint_results(model, runs, sel, p)
+    from ..results.journals import train_results  # multi-throw trains: journals, torsion
+
+    res.update(train_results(model.mech, runs.hist, float(runs.hist.t[sel][0])))
     _statistics(res, model, runs, sel, p)
     if model.bodies is not None:
         res["flexible"] = _flexible_results(model, runs, sel, p, res["warnings"])
