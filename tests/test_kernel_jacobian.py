@@ -1,0 +1,142 @@
+"""The compiled Jacobian of the right-hand side (crankmodal.dynamics.kernel.jacobian) for the
+implicit integrators.
+
+Oracles: a central-difference Jacobian of the generic Python path (``compiled=False``: the joints'
+and bodies' own methods, not the kernel) at random states, and whole runs with SciPy's own
+finite-difference Jacobian (the same Radau/LSODA, only the Jacobian differs)."""
+
+import numpy as np
+import pytest
+from test_dynamics_speed import _flexible_train, _slider_crank, _states
+
+from crankmodal.dynamics.kernel.jacobian import STEP_FLOOR, CompiledJacobian, jacobian_for
+from crankmodal.dynamics.model.system import N_AUX
+from crankmodal.dynamics.run.integrate import SolverSettings, integrate
+
+SETTINGS = SolverSettings(method="Radau", rtol=1e-6, atol=1e-9)
+
+
+def _atol(n, s=SETTINGS):
+    return np.concatenate([np.full(n, s.atol), np.full(n, s.atol * s.velocity_scale),
+                           np.full(N_AUX, 1e-3)])
+
+
+def _python_jacobian(sysm, t, y, vimp, steps):
+    """Central differences of the Python path's right-hand side, steps ``100 x`` the compiled
+    Jacobian's forward ones (truncation ~h^2 f''' of the columns' scale times 1e-12, round-off
+    ~eps |f| / h)."""
+    n = sysm.n
+    sysm.compiled = False
+    try:
+        J = np.zeros((y.size, y.size))
+        for c in range(2 * n):
+            h = 100.0 * steps[c]
+            yp, ym = y.copy(), y.copy()
+            yp[c] += h
+            ym[c] -= h
+            J[:, c] = (sysm.rhs(t, yp, vimp) - sysm.rhs(t, ym, vimp)) / (2.0 * h)
+    finally:
+        sysm.compiled = True
+    return J
+
+
+def _compare(mech, seed, count, rel):
+    """Compiled Jacobian against the Python path's central differences at ``count`` random
+    states: each column within ``rel`` of its largest entry. Returns the largest error seen."""
+    sysm = mech.system
+    n = sysm.n
+    worst = 0.0
+    for t, q, qd, y, v_impact in _states(mech, seed, count):
+        vimp = np.array([v_impact] * len(sysm.clearances))
+        jac = CompiledJacobian(sysm.kernel(), vimp, _atol(n), SETTINGS.rtol)
+        J = jac(t, y)
+        steps = np.sqrt(np.finfo(float).eps) * np.maximum(np.abs(y[:2 * n]), jac.floor)
+        ref = _python_jacobian(sysm, t, y, vimp, steps)
+        scale = np.max(np.abs(ref), axis=0) + 1e-300
+        err = np.max(np.abs(J - ref), axis=0) / scale
+        worst = max(worst, float(np.max(err[:2 * n])))
+        # the exact blocks: d(qd)/d(qd) = I, nothing depends on the work integrals
+        np.testing.assert_array_equal(J[:n, n:2 * n], np.eye(n))
+        np.testing.assert_array_equal(J[:n, :n], 0.0)
+        np.testing.assert_array_equal(J[:, 2 * n:], 0.0)
+    assert worst <= rel, worst
+    return worst
+
+
+# A forward difference with step h = sqrt(eps) max(|y|, STEP_FLOOR atol / rtol) (1.5e-9 m,
+# 1.5e-9 rad, 1.5e-6 m/s here) is off by h |f''| / 2: about h / L of the column's scale, L the
+# length over which the derivative itself changes. For the flexible bodies (L ~ 0.1 m or
+# rad) that is ~1e-7, and round-off of the terms (eps |f| / h) ~1e-5 of the crank angle's
+# column (seen: 2.8e-5); SMOOTH = 1e-4. A contact or an oil film changes its stiffness over a
+# fraction of the clearance (the film as (1 - eps^2)^-5/2 over c (1 - eps) ~ 1e-5 m): h / L ~
+# 1e-4 (seen: 1.6e-4, the same against central steps 1, 10 and 100 times h, so it is the
+# forward difference's own error); CONTACT = 1e-3. Radau's and LSODA's Newton iterations need
+# the Jacobian to a few per cent only. A wrong term shows as 1e-2 or more (checked: the
+# perturbed system's residual taken with the unperturbed matrix, and a drive's speed sign).
+SMOOTH, CONTACT = 1e-4, 1e-3
+
+
+def test_flexible_train_jacobian_equals_central_differences_of_the_python_path():
+    """Flexible crank (5 modes + 2 tilts) and two flexible rods (5 modes) on ideal joints, the
+    pistons' gas force a Python function of the crank angle (per-column gas forces)."""
+    mech = _flexible_train(clearance=False)
+    assert mech.system.kernel() is not None and mech.system.kernel()._py_gas
+    _compare(mech, 5, 6, SMOOTH)
+
+
+@pytest.mark.parametrize("bore", ["round", "film"])
+def test_clearance_jacobian_equals_central_differences_of_the_python_path(bore):
+    """Rigid slider-crank pair with a big-end clearance: dry (in and out of contact at the
+    random states) and floating on seed 001's short-bearing film (the reduced and the whole KKT
+    system of the kernel)."""
+    _compare(_slider_crank("hunt_crossley", "coulomb", bore=bore), 7, 6, CONTACT)
+
+
+def test_the_step_floor_is_the_one_documented():
+    assert STEP_FLOOR == 100.0
+
+
+def test_jacobian_only_for_implicit_methods_on_the_kernel():
+    mech = _flexible_train(clearance=False)
+    sysm = mech.system
+    atol = _atol(sysm.n)
+    v = np.zeros(0)
+    assert set(jacobian_for(sysm, "Radau", v, atol, 1e-6)) == {"jac"}
+    assert jacobian_for(sysm, "RK45", v, atol, 1e-6) == {}
+    sysm.compiled = False
+    try:
+        assert jacobian_for(sysm, "Radau", v, atol, 1e-6) == {}
+    finally:
+        sysm.compiled = True
+
+
+@pytest.mark.slow
+def test_radau_with_the_compiled_jacobian_follows_the_same_trajectory(monkeypatch):
+    """The flexible train on ideal joints (smooth, no impacts), Radau at rtol 1e-6 with the
+    compiled Jacobian and with SciPy's own finite differences, against the same run at rtol
+    1e-10 (the converged trajectory). The Jacobian only steers Newton's iterations, so both runs
+    carry Radau's error at rtol 1e-6: measured 2-3e-7 of the positions' peak and 3-4e-6 of the
+    velocities' (the flexible modes' velocities, 1e-6 of a mode's amplitude times its 2 pi f)
+    against the reference, 5e-8 and 8e-7 between the two. Each must stay within 10 rtol of the
+    reference (positions) or 20 rtol (velocities) and of each other."""
+    from crankmodal.dynamics.kernel import jacobian as jm
+
+    mech = _flexible_train(clearance=False)
+    sysm, n = mech.system, mech.system.n
+    t_out = np.linspace(0.0, 0.005, 51)
+
+    def run(rtol, compiled):
+        if not compiled:
+            monkeypatch.setattr(jm, "jacobian_for", lambda *a, **k: {})
+        try:
+            return integrate(sysm, mech.q0, mech.qd0, 0.005, t_out,
+                             SolverSettings(method="Radau", rtol=rtol, atol=rtol * 1e-3)).y
+        finally:
+            monkeypatch.undo()
+
+    ref = run(1e-10, True)
+    with_jac, without = run(1e-6, True), run(1e-6, False)
+    for blk, bound in ((slice(0, n), 1e-5), (slice(n, 2 * n), 2e-5)):
+        peak = np.max(np.abs(ref[blk]))
+        for a, b in ((with_jac, ref), (without, ref), (with_jac, without)):
+            assert np.max(np.abs(a[blk] - b[blk])) <= bound * peak
