@@ -6,7 +6,7 @@ amplitudes" of 819 W (ideal) and 6711 W (clearance). Run with and without the ga
 gravity, so that each candidate meaning of the seed's numbers has a measured value.
 
 Fig. 27: clearance added cumulatively (big end 1; 1 + 2; 1 + 2 + 3; all four, each 0.1 mm, the
-others ideal); the main-bearing X excitation force per revolution.
+others ideal); the main-bearing X (and Y) excitation force per revolution.
 
 Every clearance case is an ensemble of trajectories started 1e-12 apart (as
 ``dynamics.ensemble``); each trajectory gives per-revolution values, its mean over the
@@ -126,9 +126,10 @@ def power_per_rev(P, block, n) -> dict:
     return out
 
 
-def force_x_per_rev(F, block, n) -> dict:
-    """Per-revolution numbers of the main-bearing X force (N): peak |Fx|, mean (order 0),
-    RMS of the fluctuation, order 1-4 amplitudes and the RMS above order 12 (> 296 Hz)."""
+def force_per_rev(F, block, n) -> dict:
+    """Per-revolution numbers of one component of the main-bearing force (N): peak |F|, mean
+    (order 0), RMS of the fluctuation, order 1-4 amplitudes and the RMS above order 12
+    (> 296 Hz)."""
     out = {k: np.zeros(n) for k in ("peak", "mean", "rms_fluctuation", "rms_above_12")}
     orders = np.zeros((n, 4))
     for i in range(n):
@@ -150,10 +151,12 @@ def trajectory_numbers(hist, p, rev_hz) -> dict:
 
     t0, block, n = window(hist.t, p, rev_hz)
     pw = power_per_rev(hist.drive_power, block, n)
-    fx = force_x_per_rev(hist.main_bearing_force[:, 0], block, n)
+    fx = force_per_rev(hist.main_bearing_force[:, 0], block, n)
+    fy = force_per_rev(hist.main_bearing_force[:, 1], block, n)
     out = {"window_start_s": t0, "n_revolutions": n,
            "power": {k: summarise(v) for k, v in pw.items()},
            "force_x": {k: summarise(v) for k, v in fx.items()},
+           "force_y": {k: summarise(v) for k, v in fy.items()},
            "impacts": int(sum(len(o) for o in hist.onsets.values())) if hist.onsets else 0,
            "rhs_evals": int(hist.nfev), "wall_time_s": float(hist.wall_time)}
     return out
@@ -162,7 +165,7 @@ def trajectory_numbers(hist, p, rev_hz) -> dict:
 def ensemble_of(rows: list[dict]) -> dict:
     """Mean over trajectories of each per-trajectory mean, its spread and standard error."""
     out = {}
-    for group in ("power", "force_x"):
+    for group in [g for g in ("power", "force_x", "force_y") if g in rows[0]]:
         out[group] = {}
         for key in rows[0][group]:
             v = np.array([r[group][key]["mean"] for r in rows], float)
@@ -278,7 +281,7 @@ def plot(out: Path) -> None:
             ax.set_title(name, fontsize=9)
             ax.set_ylabel("drive power amplitude per revolution, W")
             ax.grid(alpha=0.3, axis="y")
-        axes[0][0].legend(fontsize=7, loc="upper left")
+        axes[0][0].legend(fontsize=7, loc="upper right")
         fig.suptitle("Seed 000 Fig. 23: drive-power amplitude after the start-up (dotted: the "
                      "seed's 819 W ideal, 6711 W clearance; bars ± 2 SE)", fontsize=9)
         fig.tight_layout()
@@ -288,29 +291,34 @@ def plot(out: Path) -> None:
     if f27.is_file():
         d = json.loads(f27.read_text())
         names = list(d)
-        keys = (("peak", "per-rev peak |Fx|"), ("order_1", "order 1 of Fx"),
-                ("rms_above_12", "Fx RMS above order 12 (> 296 Hz)"),
-                ("mean", "Fx mean (order 0)"))
-        fig, axes = plt.subplots(1, len(keys), figsize=(15, 4.0))
+        groups = [g for g in ("force_x", "force_y") if g in d[names[0]]["ensemble"]]
+        keys = (("peak", "per-rev peak |F{c}|"), ("order_1", "order 1 of F{c}"),
+                ("rms_above_12", "F{c} RMS above order 12 (> 296 Hz)"),
+                ("rms_fluctuation", "F{c} RMS of the fluctuation"))
+        fig, axes = plt.subplots(len(groups), len(keys), figsize=(15, 3.6 * len(groups)),
+                                 squeeze=False)
         x = np.arange(len(names))
-        for ax, (k, label) in zip(axes, keys):
-            e = [d[n]["ensemble"]["force_x"][k] for n in names]
-            ax.bar(x, [v["mean"] / 1e3 for v in e], yerr=[2 * v["sem"] / 1e3 for v in e],
-                   capsize=4, color="C0")
-            ax.plot(x, [v["min"] / 1e3 for v in e], "k_", ms=12)
-            ax.plot(x, [v["max"] / 1e3 for v in e], "k_", ms=12)
-            ideal = d[names[0]]["ideal"]["force_x"][k]["mean"] / 1e3
-            ax.axhline(ideal, color="0.3", ls="--", lw=0.9, label="ideal joints")
-            ax.set_xticks(x, [n.replace("case ", "") for n in names])
-            ax.set_xlabel("case (clearance in big ends 1..k)")
-            ax.set_title(label, fontsize=9)
-            ax.set_ylabel("kN")
-            ax.grid(alpha=0.3, axis="y")
-        axes[0].legend(fontsize=7)
+        for row, g in zip(axes, groups):
+            c = g[-1].upper()
+            for ax, (k, label) in zip(row, keys):
+                e = [d[n]["ensemble"][g][k] for n in names]
+                ax.bar(x, [v["mean"] / 1e3 for v in e], yerr=[2 * v["sem"] / 1e3 for v in e],
+                       capsize=4, color="C0" if c == "X" else "C2")
+                ax.plot(x, [v["min"] / 1e3 for v in e], "k_", ms=12)
+                ax.plot(x, [v["max"] / 1e3 for v in e], "k_", ms=12)
+                ideal = d[names[0]]["ideal"][g][k]["mean"] / 1e3
+                ax.axhline(ideal, color="0.3", ls="--", lw=0.9, label="ideal joints")
+                ax.set_xticks(x, [n.replace("case ", "") for n in names])
+                ax.set_xlabel("case k: clearance in big ends 1..k")
+                ax.set_title(label.format(c=c), fontsize=9)
+                ax.set_ylabel("kN")
+                ax.grid(alpha=0.3, axis="y")
+        axes[0][0].legend(fontsize=7)
         n = d[names[0]]["ensemble"]["n_trajectories"]
-        fig.suptitle(f"Seed 000 Fig. 27: main-bearing X force with 0.1 mm clearance added "
-                     f"cumulatively (mean of {n} trajectories ± 2 SE; ticks: min and max "
-                     f"trajectory)", fontsize=9)
+        fig.suptitle(f"Seed 000 Fig. 27: main-bearing force with 0.1 mm clearance added "
+                     f"cumulatively (mean of {n} trajectories ± 2 SE; ticks: smallest and "
+                     f"largest trajectory; X along cylinders 3/4, Y along cylinders 1/2)",
+                     fontsize=9)
         fig.tight_layout()
         fig.savefig(IMG / "seed000_fig27_cumulative.png", dpi=110)
         plt.close(fig)
