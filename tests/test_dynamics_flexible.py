@@ -33,7 +33,7 @@ def reduced(tmp_path_factory):
     model = assemble(part, STEEL)
     itf = make_interfaces(part, [{"region": "end_x0", "kind": "rigid"},
                                  {"region": "end_x1", "kind": "rigid"}])
-    body, _ = reduce_body(model, itf, n_modes=12, name="bar")
+    body, _ = reduce_body(model, itf, fixed_interface_modes=12, name="bar")
     path = tmp_path_factory.mktemp("flex") / "bar.npz"
     save_flexbody(path, body)
     return SimpleNamespace(path=path, model=model, itf=itf, body=body)
@@ -51,8 +51,9 @@ def _history(sysm, body, integ):
 
 def _random_state(flex, seed=1):
     rng = np.random.default_rng(seed)
-    q = np.concatenate([rng.normal(size=2) * 0.1, [0.7], rng.normal(size=flex.n_modes) * 1e-3])
-    qd = np.concatenate([rng.normal(size=2), [30.0], rng.normal(size=flex.n_modes)])
+    k = flex.n_coordinates
+    q = np.concatenate([rng.normal(size=2) * 0.1, [0.7], rng.normal(size=k) * 1e-3])
+    qd = np.concatenate([rng.normal(size=2), [30.0], rng.normal(size=k)])
     return q, qd
 
 
@@ -65,7 +66,7 @@ def test_mass_matrix_is_the_kinetic_energy_of_the_fe_mesh(reduced):
     Ms = model.M[0::3, 0::3]
     P = model.points
     # mode shapes on the mesh: rebuild them from the same reduction (V W)
-    _, cb = reduce_body(model, reduced.itf, n_modes=12, name="bar")
+    _, cb = reduce_body(model, reduced.itf, fixed_interface_modes=12, name="bar")
     shapes = cb.V @ fb.cb_to_modal[:, ~fb.rigid][:, keep]
     Phi = shapes.reshape(len(P), 3, -1)[:, :2]  # (p, 2, k)
     q, qd = _random_state(flex)
@@ -126,7 +127,7 @@ def test_free_tumbling_bar_conserves_kinetic_strain_potential_energy(reduced):
     its first in-plane bending and axial modes, exchanges rotational, strain and elastic kinetic
     energy (centrifugal coupling b, Coriolis S) while their sum stays constant."""
     flex = load_flexible_body(reduced.path, "bar", damping_ratio=0.0)
-    k = flex.n_modes
+    k = flex.n_coordinates
     axial = int(np.argmax(np.abs(flex.b)))
     q0 = np.zeros(3 + k)
     q0[3] = 2e-3
@@ -182,7 +183,7 @@ def test_struck_pinned_pinned_bar_rings_at_the_fe_frequency(oracle, reduced):
     pins' x equations are dependent."""
     f_fe = _pinned_pinned_fe_hz(reduced)
     flex = load_flexible_body(reduced.path, "bar", damping_ratio=0.0, cutoff_hz=6000.0)
-    k = flex.n_modes
+    k = flex.n_coordinates
     ends = {n: flex.frames[n][0] for n in ("end_x0", "end_x1")}
     ground = Ground(frames={"p0": tuple(ends["end_x0"]), "p1": tuple(ends["end_x1"])})
     sysm = Multibody([flex], [Revolute("p0", ground, "p0", flex, "end_x0"),
@@ -225,7 +226,8 @@ def test_bad_input_is_refused_by_name(reduced, tmp_path):
 def test_cutoff_selects_in_plane_modes_and_reports_what_the_plane_drops(reduced):
     f_all = load_flexible_body(reduced.path, "bar").frequencies_hz
     flex = load_flexible_body(reduced.path, "bar", cutoff_hz=2000.0)
-    assert np.all(flex.frequencies_hz <= 2000.0) and flex.n_modes == np.sum(f_all <= 2000.0)
+    assert np.all(flex.frequencies_hz <= 2000.0)
+    assert flex.n_coordinates == np.sum(f_all <= 2000.0)
     lo = flex.left_out()
     assert max(lo["out_of_plane_mass_share"]) < 1e-3
     # the out-of-plane bending modes (z, the thin direction) are the lowest and not offered

@@ -40,7 +40,7 @@ def _reduced(tmp_path_factory, R, name):
     model = assemble(part, STEEL)
     itf = make_interfaces(part, [{"region": "end_x0", "kind": "rigid"},
                                  {"region": "end_x1", "kind": "rigid"}])
-    body, cb = reduce_body(model, itf, n_modes=12, name=name)
+    body, cb = reduce_body(model, itf, fixed_interface_modes=12, name=name)
     path = tmp_path_factory.mktemp(name) / f"{name}.npz"
     save_flexbody(path, body)
     return SimpleNamespace(path=path, model=model, itf=itf, body=body, cb=cb)
@@ -67,7 +67,7 @@ def test_tilts_and_orientation_keep_the_kinetic_energy_of_the_fe_mesh(skew):
     fb, model = skew.body, skew.model
     o = 0.4
     flex = load_flexible_body(skew.path, "skew", tilt=True, orientation=o, min_in_plane=0.0)
-    assert flex.n_tilt == 2 and flex.n_elastic == flex.n_modes - 2
+    assert flex.n_tilt == 2 and flex.n_elastic == flex.n_coordinates - 2
     assert np.abs(flex.b[-2:]).max() > 1e-4 and np.abs(flex.c[-2:]).max() > 1e-4
     Ms = model.M[0::3, 0::3]
     P = model.points
@@ -80,7 +80,7 @@ def test_tilts_and_orientation_keep_the_kinetic_energy_of_the_fe_mesh(skew):
     ty = np.column_stack([zb, np.zeros_like(zb)])
     Phi = np.concatenate([Phi, tx[:, :, None], ty[:, :, None]], axis=2)
     rng = np.random.default_rng(3)
-    k = flex.n_modes
+    k = flex.n_coordinates
     q = np.concatenate([[0.1, -0.2, 0.7], rng.normal(size=k) * 1e-3])
     qd = np.concatenate([[1.0, 2.0, 30.0], rng.normal(size=k)])
     Ro = np.array([[np.cos(-o), -np.sin(-o)], [np.sin(-o), np.cos(-o)]])
@@ -128,7 +128,7 @@ def _antisymmetric_x_mode(flex):
 def _ring(flex, t_end, j, n_out=2001):
     ends = ("end_x0", "end_x1")
     ground = Ground(frames={"j": (0.0, 0.0)})
-    k = flex.n_modes
+    k = flex.n_coordinates
     sysm = Multibody([flex], [Revolute(f"j{i}", ground, "j", flex, e) for i, e in enumerate(ends)])
     q0 = np.zeros(3 + k)
     qd0 = np.zeros(3 + k)

@@ -159,3 +159,35 @@ def test_the_name_form_warns_and_builds_the_same_kernel_tables():
     assert np.array_equal(a.I, b.I) and np.array_equal(a.io, b.io)
     assert np.array_equal(a.F, b.F) and np.array_equal(a.fo, b.fo)
     assert by_name.system.clearances[0].law == Impact(**law)
+
+
+# --- one name per meaning: n_coordinates, fixed_interface_modes ---------------------------------
+
+def test_reduce_body_fixed_interface_modes_and_its_deprecated_name():
+    """The old keyword gives the same reduced body (same basis size and frequencies) and warns;
+    the argument's errors name fixed_interface_modes."""
+    import numpy as np
+
+    from crankmodal.dynamics.flexible.body import planar_body
+    from crankmodal.fem.assembly import assemble
+    from crankmodal.fem.materials import Material
+    from crankmodal.fem.testparts import bar
+    from crankmodal.reduction.interfaces import make_interfaces
+    from crankmodal.reduction.reduce import reduce_body
+
+    part = bar(0.5, 0.03, 0.02, (10, 2, 1), order=2)
+    model = assemble(part, Material("steel", 2.1e11, 0.3, 7850.0))
+    itf = make_interfaces(part, [{"region": "end_x0", "kind": "rigid"},
+                                 {"region": "end_x1", "kind": "rigid"}])
+    body, _ = reduce_body(model, itf, fixed_interface_modes=4, name="bar", stress=False)
+    with pytest.warns(DeprecationWarning, match="fixed_interface_modes"):
+        old, _ = reduce_body(model, itf, n_modes=4, name="bar", stress=False)
+    assert body.n_modes == old.n_modes == 12 + 4  # 2 interfaces x 6 + 4 fixed-interface
+    np.testing.assert_allclose(old.frequencies_hz, body.frequencies_hz, rtol=1e-12)
+    with pytest.raises(ParameterError) as err:
+        reduce_body(model, itf, fixed_interface_modes=10**6, name="bar", stress=False)
+    assert err.value.argument == "fixed_interface_modes"
+    flex = planar_body(body, "bar", n_modes=3)
+    assert flex.n_elastic == 3 and flex.n_coordinates == 3 + flex.n_tilt
+    with pytest.warns(DeprecationWarning, match="n_coordinates"):
+        assert flex.n_modes == flex.n_coordinates

@@ -44,7 +44,7 @@ def test_distributing_reduction_converges_to_full_free_free_frequencies(oracle, 
     itf = _ends(part, "distributing")
     errors = []
     for k in (0, 5, 10, 20):
-        body, _ = reduce_body(model, itf, n_modes=k)
+        body, _ = reduce_body(model, itf, fixed_interface_modes=k)
         f = body.elastic_frequencies_hz[:6]
         assert np.all(f >= full * (1 - 1e-9))  # Rayleigh–Ritz upper bounds
         errors.append(f / full - 1)
@@ -66,7 +66,7 @@ def test_rigid_reduction_converges_to_the_tied_full_model(oracle, bar_model):
     Mt = (T.T @ model.M @ T).tocsc()[keep][:, keep]
     lam = np.sort(spla.eigsh(Kt, 12, Mt, sigma=-1e3, which="LM", return_eigenvectors=False))
     tied = np.sqrt(np.abs(lam[6:12])) / (2 * np.pi)  # scipy ARPACK + SuperLU: another solver
-    body, _ = reduce_body(model, itf, n_modes=20)
+    body, _ = reduce_body(model, itf, fixed_interface_modes=20)
     rel = body.elastic_frequencies_hz[:6] / tied - 1
     oracle(stage="reduction", quantity="Craig-Bampton (RBE2 ends, 20 modes), first elastic frequency, Hz", reference="full model with the same ties, ARPACK + SuperLU (second formulation)", tolerance="0.5 %, from above", measured=body.elastic_frequencies_hz[0], expected=tied[0])
     assert np.all(rel > -1e-9) and rel.max() < 0.005, rel
@@ -112,7 +112,7 @@ def test_constraint_modes_reproduce_static_interface_loads_exactly_rbe2(bar_mode
 def test_reduced_mass_gives_bar_mass_centre_of_mass_and_inertia(bar_model):
     """Rigid fields in reduced coordinates, closed form for a prism ρ b h L."""
     part, model = bar_model
-    body, _ = reduce_body(model, _ends(part, "distributing"), n_modes=4)
+    body, _ = reduce_body(model, _ends(part, "distributing"), fixed_interface_modes=4)
     m = STEEL.rho * B * H * L
     assert body.mass_kg == pytest.approx(m, rel=1e-10)
     assert np.allclose(body.centre_of_mass, [L / 2, 0, 0], atol=1e-10 * L)
@@ -129,7 +129,7 @@ def test_reduced_mass_gives_bar_mass_centre_of_mass_and_inertia(bar_model):
 def test_orthonormalised_basis_is_m_orthonormal_k_diagonal_with_six_rigid_modes(bar_model, kind):
     part, model = bar_model
     itf = _ends(part, kind)
-    body, cb = reduce_body(model, itf, n_modes=12)
+    body, cb = reduce_body(model, itf, fixed_interface_modes=12)
     Vo = cb.V @ body.cb_to_modal
     Mo = Vo.T @ (model.M @ Vo)
     Ko = Vo.T @ (model.K @ Vo)
@@ -167,7 +167,7 @@ def test_orthonormalised_basis_is_m_orthonormal_k_diagonal_with_six_rigid_modes(
 def test_elastic_modes_meet_mean_axis_conditions_and_unit_modal_mass(bar_model):
     """Free-free elastic modes are M-orthogonal to rigid motion: ∫ρφ = 0, ∫ρ x × φ = 0."""
     part, model = bar_model
-    body, _ = reduce_body(model, _ends(part, "rigid"), n_modes=6)
+    body, _ = reduce_body(model, _ends(part, "rigid"), fixed_interface_modes=6)
     inv = body.invariants
     scale = np.sqrt(body.mass_kg) * L
     assert np.abs(inv["I3"]).max() < 1e-10 * scale
@@ -180,7 +180,7 @@ def test_invariants_i8_i9_are_derivatives_of_the_deformed_inertia_tensor(bar_mod
     """J(x + εφ) = I7 + ε (I8 + I8ᵀ) + ε² I9[:, :, a, a]: central differences are exact for
     a quadratic, so they check I8 and I9 to round-off."""
     part, model = bar_model
-    body, cb = reduce_body(model, _ends(part, "distributing"), n_modes=6)
+    body, cb = reduce_body(model, _ends(part, "distributing"), fixed_interface_modes=6)
     Ms = model.M[0::3, 0::3]
     phi = (cb.V @ body.cb_to_modal)[:, ~body.rigid][:, [0, 3]]
     inv = inertia_invariants(model.points, Ms, phi)

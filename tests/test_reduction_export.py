@@ -28,7 +28,7 @@ def reduced():
     model = assemble(part, STEEL)
     itf = make_interfaces(part, [{"region": "end_x0", "kind": "rigid"},
                                  {"region": "end_x1", "kind": "rigid"}])
-    body, cb = reduce_body(model, itf, n_modes=12, name="bar", mesh=part.mesh)
+    body, cb = reduce_body(model, itf, fixed_interface_modes=12, name="bar", mesh=part.mesh)
     return part, model, body, cb
 
 
@@ -82,7 +82,7 @@ def test_npz_carries_mesh_and_shapes_and_old_files_still_load(reduced, tmp_path)
 
 def test_no_mesh_no_shapes_and_a_clear_error(reduced, tmp_path):
     model = reduced[1]
-    nomesh, _ = reduce_body(model, _interfaces(reduced), n_modes=4, name="bar")
+    nomesh, _ = reduce_body(model, _interfaces(reduced), fixed_interface_modes=4, name="bar")
     assert nomesh.mode_shapes is None and not nomesh.has_mesh
     with pytest.raises(ValueError, match="carries no mesh"):
         export.write_modes_vtu(tmp_path / "m.vtu", nomesh)
@@ -300,7 +300,7 @@ def test_a_spinning_bar_moves_alike_in_exudyn_and_in_crankmodals_dynamics(reduce
     keep = [int(np.argmin(np.abs(fe - f))) for f in flex.frequencies_hz]  # planar -> 3D index
     axial = int(np.argmax(np.abs(flex.b)))
     spin, a0, periods, per = 500.0, 2e-3, 5, 800
-    k = flex.n_modes
+    k = flex.n_coordinates
     t_end = periods / flex.frequencies_hz[0]
     t_out = np.linspace(0.0, t_end, 501)
     q0, qd0 = np.zeros(3 + k), np.zeros(3 + k)

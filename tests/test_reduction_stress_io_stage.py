@@ -29,7 +29,8 @@ def clamped_bar():
     model = assemble(part, STEEL)
     itf = make_interfaces(part, [{"region": "end_x0", "kind": "rigid"},
                                  {"region": "end_x1", "kind": "rigid"}])
-    body, cb = reduce_body(model, itf, n_modes=6, mesh=part.mesh, stress_dtype=np.float64)
+    body, cb = reduce_body(model, itf, fixed_interface_modes=6, mesh=part.mesh,
+                           stress_dtype=np.float64)
     return part, model, body, cb
 
 

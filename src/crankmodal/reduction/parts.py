@@ -305,9 +305,10 @@ def _reduce(model, itf, modes: int, mesh, name: str, info: dict, key: str):
     from .reduce import reduce_body
 
     try:
-        return reduce_body(model, itf, n_modes=modes, mesh=mesh, name=name, info=info)[0]
+        return reduce_body(model, itf, fixed_interface_modes=modes, mesh=mesh, name=name,
+                           info=info)[0]
     except ParameterError as exc:
-        raise _relabelled(exc, key, {"n_modes": "fixed_interface_modes"}) from None
+        raise _relabelled(exc, key, {}) from None
 
 
 def reduced_part(machine: str, part: str, spec: dict, n_rods: int = 1,

@@ -10,25 +10,28 @@ import time
 
 import numpy as np
 
+from ..errors import ParameterError
 from .craig_bampton import craig_bampton
 from .flexbody import FlexibleBody, flexible_body
 from .interfaces import Interface, interface_rigid_fields
 from .orthonormal import orthonormalise
 
 
-def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
+def reduce_body(model, interfaces: list[Interface], fixed_interface_modes: int | None = None,
                 cutoff_hz: float | None = None, backend: str = "auto", mesh=None,
                 stress_dtype=np.float32, name: str = "body",
                 info: dict | None = None, stress: bool = True,
-                shape_dtype=np.float32) -> tuple[FlexibleBody, object]:
+                shape_dtype=np.float32, *, n_modes: int | None = None
+                ) -> tuple[FlexibleBody, object]:
     """Reduce an FE model to a flexible body.
 
     Parameters
     ----------
     model : crankmodal.fem.assembly.FEModel
     interfaces : list of Interface
-    n_modes, cutoff_hz : int or float
-        Fixed-interface modes: a number, or all up to a frequency (Hz). Exactly one.
+    fixed_interface_modes, cutoff_hz : int or float
+        Fixed-interface (Craig-Bampton) modes: a number, or all up to a frequency (Hz).
+        Exactly one.
     backend : str
         ``auto``, ``pardiso`` or ``superlu``.
     mesh : meshio.Mesh, optional
@@ -44,6 +47,8 @@ def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
         Compute the stress modes when the mesh is given.
     shape_dtype : numpy dtype
         Storage type of the mode shapes.
+    n_modes : int, optional
+        Deprecated name of ``fixed_interface_modes`` (a DeprecationWarning).
 
     Returns
     -------
@@ -52,7 +57,22 @@ def reduce_body(model, interfaces: list[Interface], n_modes: int | None = None,
     cb : CraigBamptonBasis
         With the full-size basis ``cb.V`` (for checks and visualisation).
     """
-    cb = craig_bampton(model, interfaces, n_modes=n_modes, cutoff_hz=cutoff_hz, backend=backend)
+    if n_modes is not None:
+        import warnings
+
+        if fixed_interface_modes is not None:
+            raise ParameterError("n_modes", "is the deprecated name of fixed_interface_modes; "
+                                 "give one of them")
+        warnings.warn("reduce_body(n_modes=...) is deprecated: use fixed_interface_modes=",
+                      DeprecationWarning, stacklevel=2)
+        fixed_interface_modes = n_modes
+    try:
+        cb = craig_bampton(model, interfaces, n_modes=fixed_interface_modes,
+                           cutoff_hz=cutoff_hz, backend=backend)
+    except ParameterError as exc:  # this function's name for craig_bampton's n_modes
+        if exc.argument != "n_modes":
+            raise
+        raise ParameterError("fixed_interface_modes", exc.text) from None
     from ..progress import PhaseTimings
 
     if hasattr(cb.timings, "close"):

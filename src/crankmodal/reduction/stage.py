@@ -129,8 +129,9 @@ def run(p: dict, ctx) -> dict:
         model, t_asm = timed_fe_model(ctx, part, mat)
         with scene_keys(SECTION, interface_keys(p)):
             itf = make_interfaces(part, interface_specs(part, p))
-        with scene_keys(SECTION):
-            body, cb = reduce_body(model, itf, n_modes=p["n_modes"], cutoff_hz=p["cutoff_hz"],
+        with scene_keys(SECTION, {"fixed_interface_modes": "n_modes"}):
+            body, cb = reduce_body(model, itf, fixed_interface_modes=p["n_modes"],
+                                   cutoff_hz=p["cutoff_hz"],
                                    backend=p["backend"], mesh=part.mesh, stress=p["stress_modes"],
                                    name=part.name, info={"part": part.name, "material": mat.name})
         timings = {"assembly_s": t_asm, **body.info["timings_s"]}

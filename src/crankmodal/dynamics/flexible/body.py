@@ -90,7 +90,28 @@ class FlexibleBody:
         Axial position of the body's plane, m (3D moments only, as :class:`RigidBody`).
     info : dict
         Provenance and what the plane leaves out (:meth:`left_out`).
+
+    Attributes
+    ----------
+    n_coordinates : int
+        Modal coordinates of the body, ``k``: its kept elastic modes (``n_elastic``, what
+        ``[dynamics.flexible] n_modes`` counts) plus ``n_tilt`` tilt coordinates (0 or 2).
+        ``n_modes`` is its deprecated former name.
+    n_elastic, n_tilt : int
+        Kept elastic modes; tilt coordinates.
+    ndof : int
+        ``3 + n_coordinates``.
     """
+
+    @property
+    def n_modes(self) -> int:
+        """Deprecated name of :attr:`n_coordinates` (elastic modes and tilts)."""
+        import warnings
+
+        warnings.warn("FlexibleBody.n_modes is deprecated: use n_coordinates (elastic modes "
+                      "plus tilts; n_elastic counts the kept elastic modes)", DeprecationWarning,
+                      stacklevel=2)
+        return self.n_coordinates
 
     def __init__(self, name, mass, j0, centre, frequencies_hz, G, b, S, interfaces,
                  damping_ratio=DEFAULT_DAMPING, z=0.0, info=None, c=None, n_tilt=0,
@@ -101,7 +122,7 @@ class FlexibleBody:
         self.centre = np.asarray(centre, float)[:2]
         self.frequencies_hz = np.asarray(frequencies_hz, float)
         k = len(self.frequencies_hz)
-        self.n_modes = k
+        self.n_coordinates = k
         self.n_tilt = int(n_tilt)
         self.n_elastic = k - self.n_tilt
         self.ndof = 3 + k
@@ -156,7 +177,7 @@ class FlexibleBody:
     def attached_terms(self) -> tuple[float, np.ndarray, np.ndarray]:
         """The attached inertias' constant mass terms: ``Σ J_s`` (θ, θ), ``Σ J_s r_z`` (θ, ξ;
         shape (k,)) and ``Σ J_s r_z r_zᵀ`` (ξ, ξ; shape (k, k)), kg m², kg m² per ξ, …"""
-        k = self.n_modes
+        k = self.n_coordinates
         h, H = np.zeros(k), np.zeros((k, k))
         for frame, J in self.attached:
             rz = self.frames[frame][2]
@@ -173,12 +194,12 @@ class FlexibleBody:
         coordinates (a rigid crank on its journals, each journal's force still defined)."""
         import copy
 
-        keep = np.arange(self.n_elastic, self.n_modes)
+        keep = np.arange(self.n_elastic, self.n_coordinates)
         twin = copy.copy(self)
         for cache in ("_stacked", "_geo", "_bias"):
             twin.__dict__.pop(cache, None)
         twin.frequencies_hz = self.frequencies_hz[keep]
-        twin.n_modes, twin.n_elastic, twin.ndof = len(keep), 0, 3 + len(keep)
+        twin.n_coordinates, twin.n_elastic, twin.ndof = len(keep), 0, 3 + len(keep)
         for a in ("zeta", "K", "C", "b", "c"):
             setattr(twin, a, getattr(self, a)[keep])
         twin.G, twin.S = self.G[np.ix_(keep, keep)], self.S[np.ix_(keep, keep)]
@@ -253,7 +274,7 @@ class FlexibleBody:
         names = tuple(self.frames)
         if getattr(self, "_stacked", (None,))[0] != names:
             idx = {n: i for i, n in enumerate(names)}
-            F, k = len(names), self.n_modes
+            F, k = len(names), self.n_coordinates
             S0 = np.array([self.frames[n][0] for n in names], float).reshape(F, 2)
             D = np.array([self.frames[n][1] for n in names], float).reshape(F, 2, k)
             RZ = np.array([self.frames[n][2] for n in names], float).reshape(F, k)

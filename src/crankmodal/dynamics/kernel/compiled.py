@@ -710,7 +710,7 @@ class CompiledSystem:
                     s0, D, rz = body.frames[frame]
                     fcol.append(sysm.slices[id(body)].start)
                     floc.append((s0[0], s0[1], 0.0))
-                    nk = body.n_modes
+                    nk = body.n_coordinates
                     fmodal.append(np.concatenate([np.ravel(D), np.ravel(rz)]))
                 else:
                     s, ph = body.local(frame)
@@ -801,7 +801,7 @@ class CompiledSystem:
             Q0[s] = b.gravity_force(z, sysm.gravity)
             if isinstance(b, FlexibleBody):
                 mdiag[s.start:s.start + 2] = b.mass
-                fb_int.append((s.start, b.n_modes, sum(a.size for a in fb_f)))
+                fb_int.append((s.start, b.n_coordinates, sum(a.size for a in fb_f)))
                 Js, h, H = b.attached_terms()
                 fb_f.append(np.concatenate([[b.mass, b.j0], b.b, b.c, np.ravel(b.G),
                                             np.ravel(b.S), b.K, b.C, [Js], h, np.ravel(H)]))
