@@ -37,6 +37,9 @@ def validate(raw: dict, scene) -> dict:
             _probe_flexbody(key, spec, p)
     if p["from_mechanism"] and (scene is None or "mechanism" not in scene.sections):
         raise SceneError("dynamics.from_mechanism: needs a [mechanism] section in the scene")
+    from .trains import check_arrangement
+
+    check_arrangement(p, scene)  # throws and firing order against the machine, before any run
     if p["speed_rpm"] is not None:
         check_speed(p, p["speed_rpm"])
     elif p["from_mechanism"]:  # [mechanism] has validated its own speed_rpm before this

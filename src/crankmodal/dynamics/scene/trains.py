@@ -88,3 +88,16 @@ def machine_cylinders(p, mechanism_params) -> dict:
             mechanism_params, p["ring_friction_n"],
             None if throws is None else [t - 1 for t in throws],
             None if order is None else [c - 1 for c in order])
+
+
+def check_arrangement(p, scene) -> None:
+    """At check time, before any stage runs: the ``[mechanism]`` machine's arrangement with the
+    keys' throws and firing order (SceneError naming the key), so nothing is written for a
+    scene the run would refuse."""
+    ct = p["crank_train"]
+    if not p["from_mechanism"] or (ct.get("cylinder_throws") is None
+                                   and ct.get("firing_order") is None):
+        return
+    from ...mechanism.stage import validate as validate_mechanism
+
+    machine_cylinders(p, validate_mechanism(scene.sections["mechanism"], scene))
