@@ -16,11 +16,13 @@ def test_a_changed_dependency_stamp_flushes_the_kernel_cache(tmp_path):
         from crankmodal.dynamics.model import clearance
         from crankmodal.dynamics.laws import lubrication
         from crankmodal.dynamics.laws import reynolds
+        from crankmodal.dynamics.model import joints
         cached = [f for f in vars(c).values()
                   if getattr(f, "_cache", None) is not None and hasattr(f, "py_func")]
         stamp = pathlib.Path(cached[0]._cache._cache_path) / "compiled.deps"
         digest = hashlib.sha256(b"".join(pathlib.Path(m.__file__).read_bytes()
-                                         for m in (clearance, lubrication, reynolds))).hexdigest()
+                                         for m in (clearance, lubrication, reynolds,
+                                                   joints))).hexdigest()
         assert stamp.read_text() == digest          # written at the first import
         assert c._flush_if_dependencies_changed() is False
         # a kernel entry in the index, then an edit of lubrication.py (its stamp changes)

@@ -255,32 +255,68 @@ class Overrun(Exception):
         self.t, self.projected, self.rate = t, projected, rate
 
 
-def projection_guard(fun, t_end: float, max_rhs_evals: int, window: float | None = None):
-    """``fun`` that stops a run whose evaluation rate shows it cannot finish.
+class ProjectionGuard:
+    """The early stop of a run whose evaluation rate shows it cannot finish.
 
     Over every window of simulated time (default ``t_end / 100``) the evaluations per simulated
     second are measured; when that rate, kept over the time left, needs more than
     :data:`GUARD_FACTOR` times the evaluations left of ``max_rhs_evals``, :class:`Overrun` is
     raised, once :data:`GUARD_START_FRACTION` of ``t_end`` has passed and
-    :data:`GUARD_BUDGET_FRACTION` of the budget (at least :data:`GUARD_MIN_EVALS`) is spent. A burst of short steps through one impact lasts far less than a window (the
-    four-star's contacts last 0.1-1 ms against a 5 ms window), so it does not stop a run; a
-    regime that holds for a window (a jammed journal, a stiff dashpot in long contact) does.
+    :data:`GUARD_BUDGET_FRACTION` of the budget (at least :data:`GUARD_MIN_EVALS`) is spent. A
+    burst of short steps through one impact lasts far less than a window (the four-star's
+    contacts last 0.1-1 ms against a 5 ms window), so it does not stop a run; a regime that
+    holds for a window (a jammed journal, a stiff dashpot in long contact) does.
+
+    The one rule for both integration paths: :func:`projection_guard` asks it at every
+    evaluation of ``solve_ivp``'s right-hand side, the compiled loop
+    (:mod:`~..kernel.integrator`) at every return to Python (every 1/200 of the run at most).
+
+    Parameters
+    ----------
+    t_end : float
+        Simulated time of the run, s.
+    max_rhs_evals : int
+        The run's budget of right-hand-side evaluations.
+    window : float or None
+        Simulated time over which the rate is measured, s (default ``t_end / 100``).
     """
-    window = window or t_end / 100.0
-    state = {"n": 0, "t0": 0.0, "n0": 0}
-    start = max(GUARD_BUDGET_FRACTION * max_rhs_evals, GUARD_MIN_EVALS)
+
+    def __init__(self, t_end: float, max_rhs_evals: int, window: float | None = None):
+        self.t_end, self.max_rhs_evals = t_end, max_rhs_evals
+        self.window = window or t_end / 100.0
+        self.start = max(GUARD_BUDGET_FRACTION * max_rhs_evals, GUARD_MIN_EVALS)
+        self.t0, self.n0 = 0.0, 0
+
+    def check(self, t: float, n: int) -> None:
+        """Judge the run at simulated time ``t`` (s) after ``n`` evaluations.
+
+        Raises
+        ------
+        Overrun
+            When the present rate needs more than :data:`GUARD_FACTOR` times the evaluations
+            left.
+        """
+        if t - self.t0 < self.window:
+            return
+        if n < self.start or t < GUARD_START_FRACTION * self.t_end:  # too early to judge
+            self.t0, self.n0 = t, n
+            return
+        rate = (n - self.n0) / (t - self.t0)
+        need = rate * (self.t_end - t)
+        if need > GUARD_FACTOR * max(self.max_rhs_evals - n, 0):
+            raise Overrun(t, n + need, rate)
+        self.t0, self.n0 = t, n
+
+
+def projection_guard(fun, t_end: float, max_rhs_evals: int, window: float | None = None):
+    """``fun`` that stops a run whose evaluation rate shows it cannot finish: its
+    :class:`ProjectionGuard` judges every evaluation (raises :class:`Overrun`)."""
+    guard = ProjectionGuard(t_end, max_rhs_evals, window)
+    count = [0]
 
     def guarded(t, y):
-        state["n"] += 1
-        if t - state["t0"] >= window:
-            if state["n"] < start or t < GUARD_START_FRACTION * t_end:  # too early to judge
-                state["t0"], state["n0"] = t, state["n"]
-                return fun(t, y)
-            rate = (state["n"] - state["n0"]) / (t - state["t0"])
-            need = rate * (t_end - t)
-            if need > GUARD_FACTOR * max(max_rhs_evals - state["n"], 0):
-                raise Overrun(t, state["n"] + need, rate)
-            state["t0"], state["n0"] = t, state["n"]
+        count[0] += 1
+        guard.check(t, count[0])
         return fun(t, y)
 
     return guarded

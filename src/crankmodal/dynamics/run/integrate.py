@@ -255,8 +255,49 @@ def _progress_rhs(rhs, pbar):
     return fun
 
 
-def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integration:
+def _failure(exc, sysm, settings, t: float) -> NumericalError:
+    """The NumericalError of a stopped run (both paths): budget, early stop, non-finite
+    accelerations, a singular matrix (near ``t`` s, or the time the exception carries), a step
+    below the floating-point spacing, a contact event firing again at its restart point."""
+    from ..kernel.integrator import EventAgain, StepFailed
+    from .budget import Overrun, regime_note
+
+    advice = _stiffness_advice(sysm, settings)
+    if isinstance(exc, BudgetExceeded):
+        return NumericalError(
+            f"integration stopped at t = {exc.t:.6g} s after {settings.max_rhs_evals} "
+            f"right-hand-side evaluations; {advice}")
+    if isinstance(exc, Overrun):
+        return NumericalError(
+            f"integration stopped at t = {exc.t:.6g} s after {sysm.nfev} right-hand-side "
+            f"evaluations: at its present {exc.rate:.3g} per simulated second (mean step "
+            f"{_per_step(settings) / exc.rate:.2g} s) the run needs about {exc.projected:.3g}, "
+            f"over solver.max_rhs_evals = {settings.max_rhs_evals}; "
+            f"{regime_note(_per_step(settings) / exc.rate, settings.time_scales)}{advice}")
+    if isinstance(exc, NonFinite):
+        return NumericalError(f"non-finite accelerations at t = {exc.t:.6g} s; {advice}")
+    if isinstance(exc, np.linalg.LinAlgError):
+        return NumericalError(
+            f"singular constraint Jacobian near t = {getattr(exc, 't', t):.6g} s: the mechanism "
+            "passes a dead point; check link lengths and the assembly branch")
+    if isinstance(exc, StepFailed):
+        return NumericalError(
+            f"integrator failed at t = {exc.t:.6g} s (Required step size is less than spacing "
+            f"between numbers.); {advice}")
+    if isinstance(exc, EventAgain):
+        return NumericalError(
+            f"integration stopped at t = {exc.t:.6g} s: a contact event fired again at the "
+            f"point the integration restarted from; {advice}")
+    raise TypeError(f"not a run failure: {exc!r}")
+
+
+def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings,
+              compiled_loop: bool = True) -> Integration:
     """Integrate a :class:`~.system.Multibody` from a consistent state.
+
+    RK45 on a system whose whole right-hand side is compiled runs in the compiled integrator
+    loop (:mod:`~..kernel.integrator`: SciPy's RK45 and its event location, inside Numba);
+    every other method and system runs ``scipy.integrate.solve_ivp``.
 
     Parameters
     ----------
@@ -269,6 +310,8 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
         Output times in ``[0, t_end]``, s; None returns the solver's own steps (then
         ``n_steps`` counts the accepted steps).
     settings : SolverSettings
+    compiled_loop : bool
+        False keeps ``solve_ivp`` for RK45 too (the reference of the compiled loop's tests).
 
     Raises
     ------
@@ -318,6 +361,28 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
     pbar = bar(total=t_end, desc="dynamics", unit="s",
                bar_format="{desc}: {n:.3g}/{total:.3g} s simulated |{bar}| "
                           "[{elapsed}<{remaining}, {rate_noinv_fmt}]")
+    from .budget import Overrun, ProjectionGuard
+
+    if compiled_loop:
+        from ..kernel import integrator
+
+        if integrator.applicable(sysm, settings.method):
+            try:
+                tt, yy, onsets, separations, peaks, _, n_steps = integrator.run(
+                    sysm, y, t_end, None if own_steps else t_out[(t_out > 0.0) & (t_out <= t_end)],
+                    settings, atol, None if pbar.disable else pbar,
+                    ProjectionGuard(t_end, settings.max_rhs_evals))
+            except (BudgetExceeded, NonFinite, np.linalg.LinAlgError, integrator.StepFailed,
+                    integrator.EventAgain, Overrun) as exc:
+                pbar.close()
+                raise _failure(exc, sysm, settings, 0.0) from None
+            pbar.close()
+            ts.append(tt)
+            ys.append(yy)
+            return Integration(t=np.concatenate(ts), y=np.concatenate(ys, axis=1),
+                               onsets=onsets, separations=separations, peaks=peaks,
+                               nfev=sysm.nfev, n_steps=n_steps,
+                               wall_time=time.perf_counter() - t0)
     # the integrator's contact memory: per clearance joint the impact velocity of its contact
     # in progress (restitution laws; constant between the restarts at onsets), passed to the
     # right-hand side, not stored in the joints
@@ -328,9 +393,14 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
 
     # a disabled bar (not a terminal, --quiet) leaves the right-hand side untouched
     fun = rhs if pbar.disable else _progress_rhs(rhs, pbar)
-    from .budget import Overrun, projection_guard, regime_note  # stop what cannot finish
+    from .budget import Overrun, projection_guard  # stop what cannot finish
 
     fun = projection_guard(fun, t_end, settings.max_rhs_evals)
+    from ..kernel.implicit import solver_options  # Radau compiled; BDF, LSODA: the Jacobian
+
+    stiff = solver_options(sysm, settings.method, v_impact, atol, settings.rtol)
+    method = stiff.pop("method", settings.method)
+    kw.update(stiff)
     while t < t_end:
         evs, tags = _events(sysm, in_contact, memory)
         te = None if own_steps else t_out[(t_out > t) & (t_out <= t_end)]
@@ -339,32 +409,11 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
                 # the work integrals have zero Jacobian columns; scipy's finite-difference
                 # step growth overflows harmlessly on them
                 warnings.filterwarnings("ignore", category=RuntimeWarning, module="scipy")
-                sol = solve_ivp(fun, (t, t_end), y, method=settings.method, t_eval=te,
+                sol = solve_ivp(fun, (t, t_end), y, method=method, t_eval=te,
                                 events=evs or None, rtol=settings.rtol, atol=atol, **kw)
-        except BudgetExceeded as exc:
+        except (BudgetExceeded, Overrun, NonFinite, np.linalg.LinAlgError) as exc:
             pbar.close()
-            raise NumericalError(
-                f"integration stopped at t = {exc.t:.6g} s after {settings.max_rhs_evals} "
-                f"right-hand-side evaluations; {_stiffness_advice(sysm, settings)}") from None
-        except Overrun as exc:
-            pbar.close()
-            raise NumericalError(
-                f"integration stopped at t = {exc.t:.6g} s after {sysm.nfev} right-hand-side "
-                f"evaluations: at its present {exc.rate:.3g} per simulated second (mean step "
-                f"{_per_step(settings) / exc.rate:.2g} s) the run needs about {exc.projected:.3g}, "
-                f"over solver.max_rhs_evals = {settings.max_rhs_evals}; "
-                f"{regime_note(_per_step(settings) / exc.rate, settings.time_scales)}"
-                f"{_stiffness_advice(sysm, settings)}") from None
-        except NonFinite as exc:
-            pbar.close()
-            raise NumericalError(
-                f"non-finite accelerations at t = {exc.t:.6g} s; {_stiffness_advice(sysm, settings)}"
-            ) from None
-        except np.linalg.LinAlgError:
-            pbar.close()
-            raise NumericalError(
-                f"singular constraint Jacobian near t = {t:.6g} s: the mechanism passes a "
-                "dead point; check link lengths and the assembly branch") from None
+            raise _failure(exc, sysm, settings, t) from None
         if sol.status == -1:
             pbar.close()
             raise NumericalError(f"integrator failed at t = {sol.t[-1]:.6g} s ({sol.message}); "
@@ -415,9 +464,9 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings) -> Integrat
             # a terminal contact event at the restart point itself, skipped above: finishing
             # here returned a history cut short without a word (seen: 0.091 of 0.3 s)
             pbar.close()
-            raise NumericalError(
-                f"integration stopped at t = {t:.6g} s: a contact event fired again at the point "
-                f"the integration restarted from; {_stiffness_advice(sysm, settings)}")
+            from ..kernel.integrator import EventAgain
+
+            raise _failure(EventAgain(t), sysm, settings, t)
         else:
             t = t_end
         if t > pbar.n:
