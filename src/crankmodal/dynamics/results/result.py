@@ -330,5 +330,6 @@ def _layout(h: History | None) -> dict | None:
             "energy": list(h.energy), "angular_acceleration": list(h.angular_acceleration),
             "onsets": list(h.onsets), "separations": list(h.separations),
             "peaks": {n: list(d) for n, d in h.peaks.items()}, "modal": list(h.modal),
-            "torsion": list(getattr(h, "torsion", {})),
-            "nfev": int(h.nfev), "wall_time": float(h.wall_time)}
+            "nfev": int(h.nfev), "wall_time": float(h.wall_time),
+            # a crank train with a motor or a flexible crank (History.torsion)
+            **({"torsion": list(h.torsion)} if getattr(h, "torsion", None) else {})}
