@@ -116,10 +116,16 @@ _EXPORTS: dict[str, tuple[str, str]] = {
     "DynamicsResult": ("crankmodal.dynamics.results.result", "DynamicsResult"),
     "simulate": ("crankmodal.dynamics.run.simulate", "simulate"),
     "quasi_static_start": ("crankmodal.dynamics.flexible.initial", "quasi_static_start"),
+    # multi-throw crank trains: the machine's arrangement, a motor through a coupling
+    "Arrangement": ("crankmodal.mechanism.arrangement", "Arrangement"),
+    "arrangement_of_machine": ("crankmodal.mechanism.arrangement", "arrangement_of_machine"),
+    "MotorDrive": ("crankmodal.dynamics.model.drive", "MotorDrive"),
+    "TorsionalCoupling": ("crankmodal.dynamics.model.loads", "TorsionalCoupling"),
 }
 
 # the same names as _EXPORTS (a literal list, for static tools); tests/test_api.py checks it
 __all__ = [
+    "Arrangement",
     "ChainModes",
     "ClearanceJoint",
     "ClearanceSpec",
@@ -146,6 +152,7 @@ __all__ = [
     "Mechanism",
     "MeshSettings",
     "Modes",
+    "MotorDrive",
     "Multibody",
     "NormalLaw",
     "NumericalError",
@@ -163,8 +170,10 @@ __all__ = [
     "StaticResult",
     "Support",
     "TorsionalChain",
+    "TorsionalCoupling",
     "TwoRotorResult",
     "__version__",
+    "arrangement_of_machine",
     "assemble",
     "bearing_load",
     "build_part",

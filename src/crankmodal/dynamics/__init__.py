@@ -28,11 +28,12 @@ order data flows:
 from .flexible.body import FlexibleBody, load_flexible_body
 from .flexible.build import crank_body, link_body, rod_body
 from .flexible.initial import quasi_static_start
+from .model.drive import MotorDrive
 from .model.mechanisms import Cylinder, Mechanism, crank_train, four_bar
 from .results.result import DynamicsResult
 from .run.integrate import SolverSettings, auto_method
 from .run.simulate import simulate, tolerance_study
 
-__all__ = ["Cylinder", "DynamicsResult", "FlexibleBody", "Mechanism", "SolverSettings",
+__all__ = ["Cylinder", "DynamicsResult", "FlexibleBody", "Mechanism", "MotorDrive", "SolverSettings",
            "auto_method", "crank_body", "crank_train", "four_bar", "link_body", "load_flexible_body",
            "quasi_static_start", "rod_body", "simulate", "tolerance_study"]

@@ -11,7 +11,7 @@ from ...errors import SceneError
 from ...schema import Field, validate
 from ..laws import contact
 from ..model.clearance import FILM_MODELS
-from .trains import TRAIN_KEYS, check_train_keys
+from . import trains as _trains
 
 MECHANISMS = ("slider_crank", "four_star", "four_bar")
 METHODS = ("auto", "LSODA", "Radau", "BDF", "RK45", "DOP853")
@@ -84,7 +84,7 @@ CRANK_TRAIN = {
     "cylinder_angles_deg": Field("floats", None, "cylinder axis angles from x, deg (slider_crank "
                                  "[0], four_star [90, 270, 0, 180])"),
     "row_z": Field("floats", None, "axial row position of each rod on the crankpin, m"),
-    **TRAIN_KEYS,  # multi-throw trains: arrangement, journals, motor (.trains)
+    **_trains.TRAIN_KEYS,  # multi-throw trains: arrangement, journals, motor (.trains)
 }
 
 FOUR_BAR = {
@@ -343,7 +343,7 @@ def _cross_checks(p):
         if not (s[0] + s[3] <= s[1] + s[2] and min(s) == l1):
             raise SceneError("dynamics.four_bar.lengths: not a crank-rocker (Grashof with the "
                              "crank shortest) for the given rocker_pivot")
-    check_train_keys(p)
+    _trains.check_train_keys(p)
     names = joint_names(p)
     seen = set()
     for i, c in enumerate(p["clearances"]):
