@@ -89,6 +89,8 @@ SCENE_TABLES: list[tuple[str, str, str, str]] = [
      "FLEX_BODY", "A flexible crank or connecting rods of a crank train."),
     ("dynamics.flexible.crank / .coupler / .rocker (four-bar)", "crankmodal.dynamics.scene.keys",
      "LINK_BODY", "A flexible link of the four-bar."),
+    ("fatigue", "crankmodal.fatigue.stage", "SCHEMA",
+     "Fatigue verdict of a flexible body of the dynamics run: [fatigue](../guide/fatigue.md)."),
     ("report", "crankmodal.report.keys", "SCHEMA",
      "The report of the whole scene: [reports](../guide/reports.md)."),
 ]

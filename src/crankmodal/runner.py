@@ -39,6 +39,7 @@ STAGES: dict[str, str] = {
     "torsion": "crankmodal.torsion.stage",
     "mechanism": "crankmodal.mechanism.stage",
     "dynamics": "crankmodal.dynamics.scene.stage",
+    "fatigue": "crankmodal.fatigue.stage",
     "report": "crankmodal.report.stage",
 }
 

@@ -28,6 +28,7 @@ TITLES = {
     "torsion": "Torsional chain and critical speeds",
     "mechanism": "Mechanism: kinematics, forces, balance, crank torque",
     "dynamics": "Dynamics",
+    "fatigue": "Fatigue verdict",
 }
 
 
@@ -433,6 +434,13 @@ def _max_deflection_um(d) -> str | None:
     return fmt(max(vals), scale=1e6, digits=3) if vals else None
 
 
+def fatigue_blocks(report: Report, res: dict) -> None:
+    """Criterion, strengths, the ensemble's spread and the per-location safety factors."""
+    from ..fatigue.report import fatigue_blocks as blocks  # nothing heavy imported
+
+    blocks(report, res)
+
+
 def geometry_blocks(report: Report, res: dict) -> None:
     """The part and its mesh (a scene without [modal]; with it the modal section has them)."""
     q = res.get("quality") or {}
@@ -455,7 +463,7 @@ def material_blocks(report: Report, res: dict) -> None:
 STAGE_BLOCKS = {"geometry": geometry_blocks, "material": material_blocks,
                 "static": static_blocks, "reduction": reduction_blocks,
                 "torsion": torsion_blocks, "mechanism": mechanism_blocks,
-                "dynamics": dynamics_blocks}
+                "dynamics": dynamics_blocks, "fatigue": fatigue_blocks}
 
 
 def stage_section(report: Report, section: str, res: dict, out_dir: Path,

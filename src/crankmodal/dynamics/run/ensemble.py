@@ -140,7 +140,8 @@ def headline_text(block: dict, n_revolutions: int) -> str:
 
 def run_ensemble(mech, base_stats: dict, n: int, t_end: float, dt: float, settings,
                  revolution_hz: float, t_start: float, v_min: dict,
-                 energy_tolerance: float | None = 1e-3, eps: float = EPS) -> dict:
+                 energy_tolerance: float | None = 1e-3, eps: float = EPS,
+                 histories: list | None = None) -> dict:
     """``n`` trajectories (the base run and ``n − 1`` perturbed ones) and their spread.
 
     Parameters
@@ -157,6 +158,9 @@ def run_ensemble(mech, base_stats: dict, n: int, t_end: float, dt: float, settin
         Hz, and the start of the first counted revolution, s.
     v_min : dict
         Impact-velocity floors per joint, m/s.
+    histories : list, optional
+        Receives the History of each perturbed trajectory (the base run's is the caller's), for
+        a later stage that assesses every trajectory (the [fatigue] verdict).
 
     Returns
     -------
@@ -179,6 +183,8 @@ def run_ensemble(mech, base_stats: dict, n: int, t_end: float, dt: float, settin
         m = replace(mech, q0=np.asarray(mech.q0, float) * (1.0 + k * eps))
         h = simulate(m, t_end, dt, settings, energy_tolerance=energy_tolerance)
         wall += h.wall_time
+        if histories is not None:
+            histories.append(h)
         st = statistics(h, revolution_hz, t_start, v_min)
         rows.append(headline(st))
         sems.append(headline(st, "sem"))

@@ -168,6 +168,7 @@ class _Runs:
     hist: object  # History
     ideal: object = None  # History of the ideal-joint twin
     rigid: object = None  # History of the rigid twin of a flexible run
+    members: list = None  # Histories of the ensemble's perturbed trajectories (dynamics.ensemble)
 
 
 def run(params: dict, ctx) -> dict:
@@ -200,7 +201,7 @@ def run(params: dict, ctx) -> dict:
     res["summary"] = _summary_line(res, model, runs.hist, sel, n_rev, study, p)
     result.save(ctx.out_dir / "dynamics.npz")
     ctx.products[SECTION] = {"mechanism": model.mech, "history": runs.hist, "ideal": runs.ideal,
-                             "rigid": runs.rigid, "result": result}
+                             "rigid": runs.rigid, "result": result, "members": runs.members}
     return dict(res)  # the runner adds its wall_time_s to the copy, not to the saved summary
 
 
@@ -251,7 +252,8 @@ def _runs(model: _Model, p: dict, ctx) -> _Runs:
     from .build import build_mechanism, solver_settings
 
     mech, t_end, dt, tol = model.mech, model.t_end, model.dt, p["energy_tolerance"]
-    runs = _Runs(simulate(mech, t_end, dt, model.settings, energy_tolerance=tol))
+    runs = _Runs(simulate(mech, t_end, dt, model.settings, energy_tolerance=tol),
+                 members=[] if "fatigue" in ctx.scene.sections else None)  # kept for [fatigue]
     if p["run_ideal"] and mech.system.clearances:
         runs.ideal = simulate(mech, t_end, dt, model.settings, ideal=True, energy_tolerance=tol)
     if model.bodies is not None and p["run_rigid"]:
@@ -357,7 +359,8 @@ def _statistics(res: dict, model: _Model, runs: _Runs, sel, p: dict) -> None:
     if p["ensemble"] > 1:
         res["ensemble"] = run_ensemble(model.mech, res["statistics"], p["ensemble"], model.t_end,
                                        model.dt, model.settings, rev_hz, t0, v_min,
-                                       energy_tolerance=p["energy_tolerance"])
+                                       energy_tolerance=p["energy_tolerance"],
+                                       histories=runs.members)
     res["headline"] = headlines(res["statistics"], res.get("ensemble"))
     if runs.ideal is None:
         return
