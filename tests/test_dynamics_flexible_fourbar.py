@@ -325,7 +325,7 @@ def _walk(d):
     ("missing", "dynamics.flexible.coupler.file: no file"),
     ("interface", "dynamics.flexible.coupler.interfaces: .*no interface 'pin'"),
     ("distance", "dynamics.flexible.rocker.file: .*rocker length is 0.145 m"),
-    ("too_many", "dynamics.flexible.coupler: .*n_modes = 99"),
+    ("too_many", "dynamics.flexible.coupler.n_modes: .*99 asked, but the file stores"),
     ("damping", "dynamics.flexible.coupler.damping_ratio"),
     ("rods", "dynamics.flexible.rods: a four_bar has no rods"),
     ("neither", "dynamics.flexible.coupler: give file"),

@@ -138,5 +138,22 @@ def path(name: str, value: Any) -> Any:
     return value
 
 
-__all__ = ["check", "instance", "integer", "number", "numbers", "one_of", "path", "table",
-           "table_by"]
+class prefixed:
+    """Re-raise a :class:`~crankmodal.errors.ParameterError` of the block under
+    ``<prefix>.<argument>``: a function that passes its argument ``spec``'s values on to
+    another core function names them as its own (``spec.n_modes``)."""
+
+    def __init__(self, prefix: str):
+        self.prefix = prefix
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if isinstance(exc, ParameterError):
+            raise ParameterError(f"{self.prefix}.{exc.argument}", exc.text) from None
+        return False
+
+
+__all__ = ["check", "instance", "integer", "number", "numbers", "one_of", "path", "prefixed",
+           "table", "table_by"]

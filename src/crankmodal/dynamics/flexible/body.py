@@ -57,7 +57,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import SceneError
+from ...errors import ParameterError
 
 DEFAULT_DAMPING = 0.02
 """Modal damping ratio of every kept mode when none is given (2 %, a common value for steel
@@ -337,8 +337,8 @@ class FlexibleBody:
         return self.info.get("left_out", {})
 
 
-def _fail(path, text, cls=SceneError):
-    raise cls(f"{path}: {text}")
+def _fail(argument, path, text):
+    raise ParameterError(argument, f"{path}: {text}")
 
 
 def load_flexible_body(path, name: str, **kwargs) -> FlexibleBody:
@@ -365,7 +365,7 @@ def load_flexible_body(path, name: str, **kwargs) -> FlexibleBody:
     ------
     InputFileError
         Not a readable crankmodal-flexbody file of version 1.
-    SceneError
+    ParameterError
         As :func:`planar_body`.
     """
     from ...reduction.io import load_flexbody
@@ -412,8 +412,10 @@ def planar_body(fb, name: str, n_modes: int | None = None,
 
     Raises
     ------
-    SceneError
-        More modes than stored, both or a bad selection, negative damping, a missing interface.
+    ParameterError
+        Naming the argument (``n_modes``, ``cutoff_hz``, ``damping_ratio``, ``interfaces``),
+        the file in its text: more modes than stored, both or a bad selection, negative
+        damping, a missing interface.
     """
     path = Path(path) if path is not None else Path(fb.name)
     el = ~np.asarray(fb.rigid, bool)
@@ -423,17 +425,18 @@ def planar_body(fb, name: str, n_modes: int | None = None,
     share = np.diag(G_all)
     offered = np.flatnonzero(share >= min_in_plane)
     if n_modes is not None and cutoff_hz is not None:
-        _fail(path, "give either n_modes or cutoff_hz, not both")
+        _fail("cutoff_hz", path, "give either n_modes or cutoff_hz, not both")
     if n_modes is not None:
         if int(n_modes) != n_modes or n_modes < 0:
-            _fail(path, f"n_modes = {n_modes!r}: must be an integer >= 0")
+            _fail("n_modes", path, f"must be an integer >= 0, got {n_modes!r}")
         if n_modes > len(offered):
-            _fail(path, f"n_modes = {n_modes}: the file stores {len(offered)} in-plane elastic "
-                        f"modes (of {int(el.sum())} elastic, in-plane share >= {min_in_plane})")
+            _fail("n_modes", path, f"{n_modes} asked, but the file stores {len(offered)} "
+                  f"in-plane elastic modes (of {int(el.sum())} elastic, in-plane share >= "
+                  f"{min_in_plane})")
         keep = offered[:int(n_modes)]
     elif cutoff_hz is not None:
         if not cutoff_hz > 0:
-            _fail(path, f"cutoff_hz = {cutoff_hz!r}: must be > 0 Hz")
+            _fail("cutoff_hz", path, f"must be > 0 Hz, got {cutoff_hz!r}")
         keep = offered[f_el[offered] <= cutoff_hz]
     else:
         keep = offered
@@ -441,13 +444,15 @@ def planar_body(fb, name: str, n_modes: int | None = None,
     zeta = np.asarray(damping_ratio, float)
     k = len(keep)
     if zeta.ndim > 1 or (zeta.ndim == 1 and len(zeta) != k):
-        _fail(path, f"damping_ratio: give one ratio or {k} (one per kept mode), got {zeta.size}")
+        _fail("damping_ratio", path, f"give one ratio or {k} (one per kept mode), got "
+              f"{zeta.size}")
     if not np.all(np.isfinite(zeta)) or np.any(zeta < 0):
-        _fail(path, f"damping_ratio = {damping_ratio!r}: must be >= 0")
+        _fail("damping_ratio", path, f"must be >= 0, got {damping_ratio!r}")
     names = list(fb.interface_names)
     for itf in interfaces or ():
         if itf not in names:
-            _fail(path, f"no interface {itf!r}; interfaces: {', '.join(names) or 'none'}")
+            _fail("interfaces", path, f"no interface {itf!r}; interfaces: "
+                  f"{', '.join(names) or 'none'}")
     cols = np.flatnonzero(el)[keep]  # columns of the elastic modes among all n
     imap = np.asarray(fb.interface_map)[:, :, cols]
     G = G_all[np.ix_(keep, keep)]

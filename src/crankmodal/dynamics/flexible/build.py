@@ -319,9 +319,10 @@ def crank_body(source, spec: dict | None = None, row_z=None, crank_radius: float
         pins.append(th["bands"][int(np.argmin(dz))])
     drive = "flywheel_end_face" if "flywheel_end_face" in centres else mains[0]
     arm1 = np.deg2rad(info[0]["angle_deg"])
-    body = planar_body(fb, name, n_modes=spec.get("n_modes"), cutoff_hz=spec.get("cutoff_hz"),
-                       damping_ratio=spec["damping_ratio"], tilt=len(mains) > 1,
-                       orientation=float(arm1), path=path)
+    with arg.prefixed("spec"):  # planar_body names n_modes: here it is spec's
+        body = planar_body(fb, name, n_modes=spec.get("n_modes"),
+                           cutoff_hz=spec.get("cutoff_hz"), damping_ratio=spec["damping_ratio"],
+                           tilt=len(mains) > 1, orientation=float(arm1), path=path)
     roles = {"mains": [], "pins": [], "drive": "drive"}
     for j, n in enumerate(mains, start=1):
         body.alias(f"main_{j}", n)
@@ -382,9 +383,10 @@ def rod_body(source, spec: dict | None = None, rod_length: float | None = None,
         raise ParameterError("source", f"{path}: its bores are {length:.5g} m apart, the "
                              f"mechanism's rod length is {rod_length:.5g} m "
                              f"(tolerance {GEOMETRY_TOLERANCE:.0%})")
-    body = planar_body(fb, name, n_modes=spec.get("n_modes"), cutoff_hz=spec.get("cutoff_hz"),
-                       damping_ratio=spec["damping_ratio"], z=z, orientation=_in_plane_angle(d),
-                       path=path)
+    with arg.prefixed("spec"):
+        body = planar_body(fb, name, n_modes=spec.get("n_modes"),
+                           cutoff_hz=spec.get("cutoff_hz"), damping_ratio=spec["damping_ratio"],
+                           z=z, orientation=_in_plane_angle(d), path=path)
     body.alias("big", "big_end_bore")
     body.alias("small", "small_end_bore")
     return body
@@ -441,9 +443,10 @@ def link_body(source, spec: dict | None = None, length: float | None = None,
         raise ParameterError("source", f"{path}: its interfaces {names[0]!r} and "
                              f"{names[1]!r} are {dist:.5g} m apart, the mechanism's {role} "
                              f"length is {length:.5g} m (tolerance {GEOMETRY_TOLERANCE:.0%})")
-    body = planar_body(fb, name or role, n_modes=spec.get("n_modes"),
-                       cutoff_hz=spec.get("cutoff_hz"), damping_ratio=spec["damping_ratio"],
-                       orientation=_in_plane_angle(d), path=path)
+    with arg.prefixed("spec"):
+        body = planar_body(fb, name or role, n_modes=spec.get("n_modes"),
+                           cutoff_hz=spec.get("cutoff_hz"), damping_ratio=spec["damping_ratio"],
+                           orientation=_in_plane_angle(d), path=path)
     joints = FOUR_BAR_JOINTS[role]
     for j, n in zip(joints, names):
         body.alias(j, n)

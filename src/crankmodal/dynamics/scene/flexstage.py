@@ -61,10 +61,17 @@ def _file(spec, machine, part, n_rods, key):
     return reduced_part(machine, part, spec, n_rods=n_rods)
 
 
+#: the body builders' arguments (:mod:`..flexible.build`, :func:`..flexible.body.planar_body`)
+#: -> their ``[dynamics.flexible.<body>]`` keys
+BODY_KEYS = {"source": "file", **{f"spec.{k}": k for k in (
+    "n_modes", "cutoff_hz", "damping_ratio", "interfaces")}}
+
+
 def body_keys(key: str):
-    """The builders' errors (:mod:`.flexbuild`: ``ParameterError`` naming ``source``,
-    ``interfaces``) re-raised under ``dynamics.flexible.<key>`` (``source`` is its ``file``)."""
-    return scene_keys(f"dynamics.flexible.{key}", {"source": "file"})
+    """The builders' errors (:mod:`..flexible.build`: ``ParameterError`` naming ``source``,
+    ``interfaces``, ``spec.n_modes``, ...; :func:`..flexible.body.planar_body`'s ``n_modes``,
+    ...) re-raised under ``dynamics.flexible.<key>`` (``source`` is its ``file``)."""
+    return scene_keys(f"dynamics.flexible.{key}", BODY_KEYS)
 
 
 def link_length(p, role: str) -> float:

@@ -94,17 +94,19 @@ def _probe_flexbody(key: str, spec: dict, p=None) -> None:
     a four-bar link its interfaces and their distance)."""
     from ...errors import InputFileError, SceneError
     from ..flexible.body import load_flexible_body
+    from .flexstage import body_keys
 
     try:
         if p is not None and p["mechanism"] == "four_bar":
             from ..flexible.build import link_body
-            from .flexstage import body_keys, link_length
+            from .flexstage import link_length
 
             with body_keys(key):
                 link_body(spec["file"], spec, link_length(p, key), key)
             return
-        load_flexible_body(spec["file"], key, n_modes=spec["n_modes"], cutoff_hz=spec["cutoff_hz"],
-                           damping_ratio=spec["damping_ratio"])
+        with body_keys(key):
+            load_flexible_body(spec["file"], key, n_modes=spec["n_modes"],
+                               cutoff_hz=spec["cutoff_hz"], damping_ratio=spec["damping_ratio"])
     except (SceneError, InputFileError) as exc:
         if str(exc).startswith("dynamics."):
             raise
