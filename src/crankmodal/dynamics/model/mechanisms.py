@@ -250,9 +250,9 @@ def _split(pins, clearances, contact_kw):
     if not hasattr(specs, "values"):
         raise ParameterError("clearances", f"must be a mapping {{joint: ClearanceSpec}}, got "
                              f"{specs!r:.60}")
-    if contact_kw or any(not isinstance(v, ClearanceSpec) for v in dict(specs).values()):
+    specs = arg.table("clearances", specs, {p.name for p in pins})  # the names first
+    if contact_kw or any(not isinstance(v, ClearanceSpec) for v in specs.values()):
         specs = clearance_specs(specs, contact_kw, stacklevel=5)
-    specs = arg.table("clearances", specs, {p.name for p in pins})
     ideal_pins, clear = [], []
     for p in pins:
         spec = specs.get(p.name)
@@ -601,7 +601,7 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         if isinstance(crank_body, tuple):
             raise ParameterError("crank_body", "got a tuple: crank_body() returns (body, roles)")
         crank_roles = _check_roles(crank_body, crank_roles, len(cylinders))
-        if drive_torque is not None and not isinstance(crank_body, RigidBody):
+        if drive_torque is not None and not isinstance(crank_body, RigidBody) and motor is None:
             raise ParameterError("drive_torque", "with a flexible crank the speed is "
                                  "prescribed (the part carries no flywheel); give None")
     elif crank_roles is not None:

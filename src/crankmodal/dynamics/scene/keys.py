@@ -388,10 +388,13 @@ def _cross_checks(p):
         raise SceneError("dynamics.crank_train.counterweight_mass_radius: needs crank_mass > 0 "
                          "(kg; the counterweight is part of the crank's mass), got crank_mass = "
                          f"{ct['crank_mass']:g}")
-    if p["drive_torque"] is not None and p["mechanism"] != "four_bar" and ct["crank_inertia"] <= 0:
+    motor = ct.get("motor_inertia") is not None  # a motor drives: the crank's part carries no
+    # flywheel, a flexible crank has its own inertia (.trains)
+    if p["drive_torque"] is not None and p["mechanism"] != "four_bar" and ct["crank_inertia"] <= 0 \
+            and not (motor and p["flexible"]["crank"] is not None):
         raise SceneError("dynamics.crank_train.crank_inertia: must be > 0 (crank and flywheel, "
                          "kg m^2) when drive_torque sets the speed free")
-    if p["flexible"]["crank"] is not None and p["drive_torque"] is not None:
+    if p["flexible"]["crank"] is not None and p["drive_torque"] is not None and not motor:
         raise SceneError("dynamics.drive_torque: with a flexible crank the speed is "
                          "prescribed (the part carries no flywheel); remove drive_torque")
     if p["drive_torque"] is not None and p["ramp_time"] > 0:
