@@ -191,3 +191,33 @@ def test_reduce_body_fixed_interface_modes_and_its_deprecated_name():
     assert flex.n_elastic == 3 and flex.n_coordinates == 3 + flex.n_tilt
     with pytest.warns(DeprecationWarning, match="n_coordinates"):
         assert flex.n_modes == flex.n_coordinates
+
+
+# --- the solver's rules live in the core; the scene keys share them ------------------------------
+
+def test_solver_settings_import_no_scene_module():
+    import subprocess
+    import sys
+
+    code = ("import sys\n"
+            "from crankmodal.dynamics.run.integrate import SolverSettings\n"
+            "SolverSettings(method='RK45', rtol=1e-8, atol=1e-12, max_rhs_evals=10)\n"
+            "bad = [m for m in sys.modules if m.startswith('crankmodal.dynamics.scene')]\n"
+            "assert not bad, bad\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300, check=False)
+    assert out.returncode == 0, out.stderr[-1500:]
+
+
+@pytest.mark.parametrize("field, value", [("rtol", 1.0), ("method", "Euler"), ("atol", 0.0),
+                                          ("max_rhs_evals", 0)])
+def test_solver_settings_and_the_scene_refuse_the_same_values(field, value):
+    from crankmodal.dynamics.run.integrate import SolverSettings
+    from crankmodal.dynamics.scene.keys import validate_section
+    from crankmodal.errors import SceneError
+
+    with pytest.raises(ParameterError) as err:
+        SolverSettings(**{field: value})
+    assert err.value.argument == field
+    with pytest.raises(SceneError, match=rf"^dynamics\.solver\.{field}: {err.value.text[:12]}"):
+        validate_section({"speed_rpm": 3000.0, "solver": {field: value}})

@@ -52,7 +52,7 @@ class SolverSettings:
     ------
     ParameterError
         Naming the field out of its range (the ``[dynamics.solver]`` keys' rules: ``method``
-        one of :data:`~.scene_keys.METHODS`, ``0 < rtol < 1``, ``atol > 0``,
+        one of :data:`~.rules.METHODS`, ``0 < rtol < 1``, ``atol > 0``,
         ``max_rhs_evals >= 1``; ``velocity_scale > 0``, ``max_step`` None or ``> 0`` s).
     """
 
@@ -66,7 +66,7 @@ class SolverSettings:
 
     def __post_init__(self):
         from ... import arguments as arg
-        from ..scene.keys import METHODS, SOLVER
+        from .rules import METHODS, SOLVER
 
         arg.one_of("method", self.method, METHODS)
         self.rtol = arg.check("rtol", self.rtol, SOLVER["rtol"])

@@ -29,7 +29,7 @@ FLOATS_PER_STATE_SAMPLE = 4
 
 def check_output(sysm, t_end: float, output_step: float) -> int:
     """Refuse a run whose output samples would not fit: more than the scene limit
-    (:data:`~.scene_keys.MAX_OUTPUT_SAMPLES`) or more memory than the machine has.
+    (:data:`~.rules.MAX_OUTPUT_SAMPLES`) or more memory than the machine has.
 
     Returns
     -------
@@ -45,7 +45,7 @@ def check_output(sysm, t_end: float, output_step: float) -> int:
     from ...errors import ParameterError
     from ...fem.memory import available_bytes
     from ..model.system import N_AUX
-    from ..scene.keys import MAX_OUTPUT_SAMPLES
+    from .rules import MAX_OUTPUT_SAMPLES
 
     samples = t_end / output_step + 1.0
     per_sample = 8.0 * FLOATS_PER_STATE_SAMPLE * (2 * sysm.n + N_AUX)
@@ -63,14 +63,15 @@ def check_output(sysm, t_end: float, output_step: float) -> int:
 
 
 def _check_run(mech, t_end, output_step, settings, energy_tolerance, start):
-    """The arguments of :func:`simulate`, by the ``[dynamics]`` keys' rules."""
+    """The arguments of :func:`simulate`, by the run rules (:mod:`.rules`, which the
+    ``[dynamics]`` keys share)."""
     from ... import arguments as arg
     from ..model.mechanisms import Mechanism
-    from ..scene.keys import FLEXIBLE, SCHEMA
+    from .rules import RUN
 
     arg.instance("mech", mech, Mechanism, "a Mechanism (crank_train, four_bar)")
-    t_end = arg.check("t_end", t_end, SCHEMA["end_time"])
-    output_step = arg.check("output_step", output_step, SCHEMA["output_step"])
+    t_end = arg.check("t_end", t_end, RUN["end_time"])
+    output_step = arg.check("output_step", output_step, RUN["output_step"])
     if output_step > t_end:
         from ...errors import ParameterError
 
@@ -79,8 +80,8 @@ def _check_run(mech, t_end, output_step, settings, energy_tolerance, start):
     if settings is not None:
         arg.instance("settings", settings, SolverSettings, "a SolverSettings or None")
     energy_tolerance = arg.check("energy_tolerance", energy_tolerance,
-                                 SCHEMA["energy_tolerance"], optional=True)
-    arg.check("start", start, FLEXIBLE["start"], optional=True)  # dynamics.flexible.start
+                                 RUN["energy_tolerance"], optional=True)
+    arg.check("start", start, RUN["start"], optional=True)
     return t_end, output_step, energy_tolerance
 
 

@@ -11,13 +11,11 @@ from ...errors import SceneError
 from ...schema import Field, validate
 from ..laws import contact
 from ..model.clearance import FILM_MODELS
+from ..run.rules import MAX_OUTPUT_SAMPLES, METHODS, RUN  # noqa: F401 (METHODS: public here)
+from ..run.rules import SOLVER as SOLVER_RULES
 from . import trains as _trains
 
 MECHANISMS = ("slider_crank", "four_star", "four_bar")
-METHODS = ("auto", "LSODA", "Radau", "BDF", "RK45", "DOP853")
-#: most output samples of one run (``end_time / output_step``): 1e7 samples of the history
-#: arrays already take gigabytes
-MAX_OUTPUT_SAMPLES = 10_000_000
 
 SCHEMA = {
     "machine": Field("str", None, "machine file whose [dynamics] table gives the defaults"),
@@ -34,9 +32,8 @@ SCHEMA = {
                        ge=0.0),
     "drive_torque": Field("float", None, "N m; if given the speed is free and this torque drives"),
     "initial_angle_deg": Field("float", 0.0, "initial crank angle, deg from the x axis"),
-    "end_time": Field("float", 0.2, "simulated time, s", gt=0.0, le=100.0),
-    "output_step": Field("float", None, "output sampling step, s (default: 1 deg of crank)",
-                         gt=0.0),
+    "end_time": RUN["end_time"],
+    "output_step": RUN["output_step"],
     "spectrum_start": Field("float", None, "start of the spectrum window, s (default: after the "
                             "ramp and one revolution)", ge=0.0),
     "gravity": Field("floats", [0.0, 0.0], "gravity vector in the plane, m/s^2", length=2),
@@ -46,8 +43,7 @@ SCHEMA = {
     "gas_cycle_deg": Field("float", 360.0, "360 (compressor, two-stroke) or 720 (four-stroke)",
                            check=lambda v: None if v in (360.0, 720.0) else "must be 360 or 720"),
     "ring_friction_n": Field("float", 0.0, "piston ring friction force, N", ge=0.0),
-    "energy_tolerance": Field("float", 1e-3, "admissible energy-balance residual (relative)",
-                              gt=0.0),
+    "energy_tolerance": RUN["energy_tolerance"],
     "run_ideal": Field("bool", True, "also run the ideal-joint twin (reference, contact loss)"),
     "crank_train": Field("table", {}, "slider-crank / four-star geometry and masses"),
     "four_bar": Field("table", {}, "four-bar geometry and masses"),
@@ -144,18 +140,13 @@ FRICTION = {
     "v_dynamic": Field("float", 1e-2, "friction transition velocity, m/s", gt=0.0),
 }
 
-SOLVER = {
-    "method": Field("str", "auto", "solve_ivp method; auto: RK45 (fastest measured, also for "
-                    "stiff contact), LSODA when friction sticks (slow sliding) or with an oil "
-                    "film; with flexible bodies Radau on ideal joints or with an oil film",
-                    choices=METHODS),
-    "rtol": Field("float", 1e-6, "relative tolerance", gt=0.0, lt=1.0),
-    "atol": Field("float", None, "absolute position tolerance, m (default min(1e-9, c/1e4))",
-                  gt=0.0),
+SOLVER = {  # the integrator's rules from the core (run.rules); the step bound in degrees here
+    "method": SOLVER_RULES["method"],
+    "rtol": SOLVER_RULES["rtol"],
+    "atol": SOLVER_RULES["atol"],
     "max_step_deg": Field("float", 2.0, "largest step, deg of crank", gt=0.0, le=90.0),
-    "max_rhs_evals": Field("int", 2_000_000, "budget of right-hand-side evaluations", gt=0),
-    "baumgarte": Field("float", None, "constraint stabilisation rate, 1/s (default 2 omega)",
-                       gt=0.0),
+    "max_rhs_evals": SOLVER_RULES["max_rhs_evals"],
+    "baumgarte": SOLVER_RULES["baumgarte"],
     "study_rtols": Field("floats", [], "tolerances of the error-against-run-time study", gt=0.0,
                          lt=1.0),
 }
@@ -170,9 +161,7 @@ FLEXIBLE = {
                      "file = \"...npz\" or bar = [width, thickness]"),
     "rocker": Field("table", {}, "four-bar: the rocker D-C as a flexible body (absent: rigid): "
                     "file = \"...npz\" or bar = [width, thickness]"),
-    "start": Field("str", "quasi_static", "initial elastic state: quasi_static (the bodies "
-                   "deformed at rest under the loads at t = 0) or undeformed",
-                   choices=("quasi_static", "undeformed")),
+    "start": RUN["start"],
 }
 
 FLEX_BODY = {
