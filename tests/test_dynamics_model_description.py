@@ -221,3 +221,66 @@ def test_solver_settings_and_the_scene_refuse_the_same_values(field, value):
     assert err.value.argument == field
     with pytest.raises(SceneError, match=rf"^dynamics\.solver\.{field}: {err.value.text[:12]}"):
         validate_section({"speed_rpm": 3000.0, "solver": {field: value}})
+
+
+# --- advice: the core names its arguments, the stage the scene keys -----------------------------
+
+SOFT = """
+[dynamics]
+mechanism = "slider_crank"
+speed_rpm = 1480.0
+end_time = 0.01
+output_step = 1e-4
+run_ideal = false
+gas_force_deg = [0.0, 180.0, 360.0]
+gas_force_n = [3500.0, 500.0, 3500.0]
+[dynamics.crank_train]
+crank_radius = 0.035
+rod_length = 0.14
+crank_mass = 2.0
+crank_inertia = 0.01
+[[dynamics.clearances]]
+joint = "big_end_1"
+clearance = 1e-4
+journal_radius = 0.02
+[dynamics.contact]
+law = "lankarani_nikravesh"
+stiffness = 1e5
+restitution = 0.5
+[dynamics.solver]
+method = "LSODA"
+"""
+
+
+def test_a_too_soft_contact_names_the_argument_in_the_core_and_the_key_in_a_scene(tmp_path):
+    from conftest import run_in_process
+
+    from crankmodal.dynamics.scene.build import relabel
+
+    # the stage's mapping: whole words only, the key in full
+    assert relabel("law.stiffness = 1e+05 is too low; tighten settings.rtol") == \
+        "dynamics.contact.stiffness = 1e+05 is too low; tighten dynamics.solver.rtol"
+    assert relabel("my_law.stiffness, law.stiffness_x") == "my_law.stiffness, law.stiffness_x"
+    scene = tmp_path / "soft.toml"
+    scene.write_text(SOFT)
+    status, err = run_in_process("run", scene, "--out", tmp_path / "out")
+    assert status == 3
+    assert "dynamics.contact.stiffness = 1e+05 is too low" in err and "law.stiffness" not in \
+        err.replace("contact.stiffness", "")
+    assert not (tmp_path / "out" / "results.json").exists()
+
+
+def test_the_penetration_warning_names_the_law_argument_by_default():
+    from types import SimpleNamespace
+
+    from crankmodal.dynamics.results.validity import penetration_warning
+    from crankmodal.dynamics.scene.build import CONTACT_WORDS
+
+    cj = SimpleNamespace(name="big_end_1", clearance=1e-4, journal_radius=0.02,
+                         bearing_length=0.02, law=Impact(stiffness=1e9, damping=300.0,
+                                                         penetration=1e-4))
+    api = penetration_warning(cj, 1e-4, 1e4)  # 100 % of the clearance
+    assert "raise law.stiffness (now 1e+09)" in api and "dynamics." not in api
+    scene = penetration_warning(cj, 1e-4, 1e4, words=CONTACT_WORDS)
+    assert "raise dynamics.contact.stiffness (now 1e+09)" in scene
+    assert "dynamics.contact.law = 'johnson_cylinder'" in scene

@@ -174,7 +174,7 @@ def test_an_api_run_is_checked_the_same_way(coupler):
     coupler.name = "coupler"
     mech = SimpleNamespace(system=SimpleNamespace(bodies=[coupler]))
     kept = []
-    with pytest.warns(ModelWarning, match="dynamics.flexible.coupler: coupler deflects"):
+    with pytest.warns(ModelWarning, match="flexible body 'coupler': coupler deflects"):
         blocks = check_flexible_bodies(mech, hist, warnings=kept)
     d_ref, _ = _closed_forms(q)
     assert blocks["coupler"]["deflection_max_m"] == pytest.approx(d_ref, rel=0.02)

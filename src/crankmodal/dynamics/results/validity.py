@@ -32,11 +32,20 @@ def elastic_approach(cj, force: float, E: float, nu: float) -> tuple[float, floa
     return float(contact.johnson_cylinder_approach(force, K, cj.clearance)), L
 
 
+#: how :func:`penetration_warning` names what to change: the law's own arguments (Python API);
+#: a stage passes its scene keys instead (:data:`..scene.build.CONTACT_WORDS`)
+LAW_WORDS = {"stiffness": "law.stiffness", "johnson_cylinder": "law = JohnsonCylinder(...)"}
+
+
 def penetration_warning(cj, depth: float, force: float, E: float = 2.1e11,
-                        nu: float = 0.3) -> str | None:
+                        nu: float = 0.3, words: dict | None = None) -> str | None:
     """The warning for a joint whose largest penetration ``depth`` (m), under its peak contact
     force ``force`` (N), exceeds :data:`CLEARANCE_FRACTION` of the clearance or
-    :data:`APPROACH_FACTOR` times the elastic approach; None when it stays inside both."""
+    :data:`APPROACH_FACTOR` times the elastic approach; None when it stays inside both.
+
+    ``E`` (Pa) and ``nu`` are the journal's and bore's elastic constants; ``words`` names what
+    to change (:data:`LAW_WORDS`, the default: the law's arguments; a stage passes its keys)."""
+    words = LAW_WORDS | (words or {})
     if not depth > 0.0:
         return None
     approach, L = elastic_approach(cj, force, E, nu)
@@ -54,8 +63,8 @@ def penetration_warning(cj, depth: float, force: float, E: float = 2.1e11,
             f"{quantity(force, 'N', 3)} ({quantity(approach, 'm', 2)}, Johnson's conformal "
             f"cylinders, L = {quantity(L, 'm', 3)}; warning above "
             f"{APPROACH_FACTOR:g} times): the contact law ({cj.law.name}) is far outside its "
-            f"validity; raise dynamics.contact.stiffness (now {K:.3g}) or use "
-            f"dynamics.contact.law = 'johnson_cylinder'")
+            f"validity; raise {words['stiffness']} (now {K:.3g}) or use "
+            f"{words['johnson_cylinder']}")
 
 
 # ------------------------------------------------------------------ flexible bodies
@@ -287,8 +296,9 @@ def validity_summary(bodies: dict) -> str:
 def check_flexible_bodies(mech, hist, t_start: float = 0.0, warnings: list | None = None) -> dict:
     """The flexible-body checks of a run made with the Python API (:func:`.analysis.simulate`),
     as a scene run makes them: each flexible body's :func:`flexible_validity` block over the
-    samples from ``t_start`` (s) on, its warnings issued as :class:`~crankmodal.errors.ModelWarning`
-    (and appended to ``warnings`` if given).
+    samples from ``t_start`` (s) on, its warnings (naming the body: ``flexible body
+    'coupler': ...``) issued as :class:`~crankmodal.errors.ModelWarning` (and appended to
+    ``warnings`` if given).
 
     Returns
     -------
@@ -296,7 +306,7 @@ def check_flexible_bodies(mech, hist, t_start: float = 0.0, warnings: list | Non
         Body name -> validity block (:func:`flexible_validity`).
     """
     from ...errors import warn
-    from ..scene.flexstage import dynamic_stress, flexible_bodies_of, flexible_key
+    from ..scene.flexstage import dynamic_stress, flexible_bodies_of
 
     sel = np.asarray(hist.t) >= t_start
     t = np.asarray(hist.t)[sel]
@@ -305,7 +315,7 @@ def check_flexible_bodies(mech, hist, t_start: float = 0.0, warnings: list | Non
         modal = np.asarray(hist.modal[b.name])[sel]
         stress = dynamic_stress(b, modal, t, np.asarray(hist.crank_angle)[sel])
         out[b.name], texts = flexible_validity(b, elastic_deflection(b, modal, t), stress,
-                                               flexible_key(b.name))
+                                               f"flexible body {b.name!r}")
         for text in texts:
             warn(text, into=warnings)
     return out

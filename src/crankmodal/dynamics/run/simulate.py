@@ -162,15 +162,15 @@ def simulate(mech, t_end, output_step, settings: SolverSettings | None = None, i
         if depth > 0.1 * cj.journal_radius:
             raise NumericalError(
                 f"clearance joint {cj.name!r}: penetration {depth:.3g} m exceeds 10 % of the "
-                f"journal radius: contact.stiffness = "
+                f"journal radius: law.stiffness = "
                 f"{getattr(cj.law, 'stiffness', float('nan')):.3g} is "
                 "too low for these loads; raise it")
     err = hist.energy_error()
     if energy_tolerance is not None and err > energy_tolerance:
         raise NumericalError(
             f"energy balance does not close: residual {err:.2e} of the energy exchanged "
-            f"(tolerance {energy_tolerance:g}); tighten solver.rtol/solver.atol or lower "
-            "solver.max_step_deg")
+            f"(tolerance {energy_tolerance:g}); tighten settings.rtol/settings.atol or lower "
+            "settings.max_step")
     return hist
 
 

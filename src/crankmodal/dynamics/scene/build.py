@@ -19,6 +19,45 @@ from .keys import cylinder_angles
 NORMAL_LAW_KEYS = {"stiffness": "stiffness", "exponent": "exponent", "damping": "damping",
                    "penetration": "penetration", "restitution": "restitution",
                    "radial_clearance": "stiffness", "law": "law"}
+#: what the core's advice names (the law's and the solver settings' arguments) -> the scene key
+#: a scene's user changes (:func:`scene_words`)
+ADVICE_KEYS = {"law.stiffness": "dynamics.contact.stiffness",
+               "law.damping": "dynamics.contact.damping",
+               "settings.rtol": "dynamics.solver.rtol", "settings.atol": "dynamics.solver.atol",
+               "settings.max_step": "dynamics.solver.max_step_deg",
+               "settings.method": "dynamics.solver.method",
+               "settings.max_rhs_evals": "dynamics.solver.max_rhs_evals"}
+#: :func:`..results.validity.penetration_warning`'s words in a scene
+CONTACT_WORDS = {"stiffness": "dynamics.contact.stiffness",
+                 "johnson_cylinder": "dynamics.contact.law = 'johnson_cylinder'"}
+
+
+def relabel(text: str, keys: dict = ADVICE_KEYS) -> str:
+    """``text`` with each argument named in ``keys`` (whole words) replaced by its scene key."""
+    import re
+
+    for argument, key in keys.items():
+        text = re.sub(rf"(?<![\w.]){re.escape(argument)}(?![\w])", key, text)
+    return text
+
+
+class scene_words:
+    """Re-raise a :class:`~crankmodal.errors.NumericalError` of the block with the arguments
+    its advice names replaced by their scene keys (:data:`ADVICE_KEYS`)."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        from ...errors import NumericalError
+
+        if isinstance(exc, NumericalError):
+            text = relabel(str(exc))
+            if text != str(exc):
+                raise NumericalError(text) from None
+        return False
+
+
 #: :class:`ClearanceSpec` field -> its ``[[dynamics.clearances]]`` key
 CLEARANCE_KEYS = {"wear_angle": "wear_angle_deg", "normal": "law", "friction": "law",
                   "v_impact_min": "v_impact_min"}

@@ -178,9 +178,12 @@ def run(params: dict, ctx) -> dict:
     summarise, draw and save; returns the results.json entry (see :class:`DynamicsResult`)."""
     from ...errors import warn
 
+    from .build import scene_words
+
     p = params
     model = _model(p, ctx)
-    runs = _runs(model, p, ctx)
+    with scene_words():  # the core's advice names its arguments; a scene user changes keys
+        runs = _runs(model, p, ctx)
     sel, n_rev, start_up = _window(runs.hist, p, model.rev_hz)
     if start_up:
         warn(_start_up_warning(p, model.rev_hz), into=model.warnings)
@@ -311,6 +314,7 @@ def _joint_results(model: _Model, runs: _Runs, sel, p: dict) -> dict:
     from ...errors import warn
     from ..results.signals import contact_durations, contact_loss_indicator, impact_statistics
     from ..results.validity import penetration_warning
+    from .build import CONTACT_WORDS
 
     hist, ideal = runs.hist, runs.ideal
     tw = (float(hist.t[sel][0]), float(hist.t[sel][-1]))
@@ -335,7 +339,7 @@ def _joint_results(model: _Model, runs: _Runs, sel, p: dict) -> dict:
         text = penetration_warning(cj, hist.peak("penetration",
                                                  np.maximum(d["penetration"], 0.0), cj.name),
                                    hist.peak("fn", d["fn"], cj.name),
-                                   p["contact"]["E"], p["contact"]["nu"])
+                                   p["contact"]["E"], p["contact"]["nu"], CONTACT_WORDS)
         if text:
             warn(text, into=model.warnings)
         if ideal is not None:
