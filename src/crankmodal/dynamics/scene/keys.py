@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 
 import numpy as np
 
 from ...errors import SceneError
 from ...schema import Field, validate
 from ..laws import contact
-from ..model.clearance import FILM_MODELS
+from ..model.clearance import RULES as CLEARANCE_RULES
 from ..run.rules import MAX_OUTPUT_SAMPLES, METHODS, RUN  # noqa: F401 (METHODS: public here)
 from ..run.rules import SOLVER as SOLVER_RULES
 from . import trains as _trains
@@ -101,18 +102,19 @@ FOUR_BAR = {
 CLEARANCE = {
     "joint": Field("str", "big_end_1", "joint name: main, big_end_i, small_end_i (crank trains); "
                    "A, B, C, D (four-bar)"),
-    "clearance": Field("float", 1e-4, "radial clearance, m", gt=0.0, le=0.01),
-    "journal_radius": Field("float", 0.02, "m", gt=0.0),
-    "clearance_major": Field("float", None, "worn bearing (seed 003): radial clearance along the "
-                             "major axis of the elliptical bore, m (clearance is the minor one)",
-                             gt=0.0, le=0.01),
+    # bounds: the core's (ClearanceSpec's RULES); defaults and docs: the scene's
+    "clearance": replace(CLEARANCE_RULES["clearance"], default=1e-4, doc="radial clearance, m"),
+    "journal_radius": replace(CLEARANCE_RULES["journal_radius"], default=0.02, doc="m"),
+    "clearance_major": replace(CLEARANCE_RULES["clearance_major"], doc="worn bearing (seed "
+                               "003): radial clearance along the major axis of the elliptical "
+                               "bore, m (clearance is the minor one)"),
     "wear_angle_deg": Field("float", 0.0, "major axis of the worn bore from the bearing body's "
                             "axis (rod axis for big and small ends), deg"),
-    "viscosity": Field("float", None, "lubricant dynamic viscosity, Pa s: adds the short-bearing "
-                       "(Ocvirk) film force", gt=0.0),
-    "bearing_length": Field("float", None, "bearing length for the film force, m", gt=0.0),
-    "film_model": Field("str", "short", "film force with viscosity: short (Ocvirk) or finite "
-                        "(Reynolds, tabulated per L/D)", choices=FILM_MODELS),
+    "viscosity": replace(CLEARANCE_RULES["viscosity"], doc="lubricant dynamic viscosity, Pa s: "
+                         "adds the short-bearing (Ocvirk) film force"),
+    "bearing_length": CLEARANCE_RULES["bearing_length"],
+    "film_model": replace(CLEARANCE_RULES["film_model"], doc="film force with viscosity: short "
+                          "(Ocvirk) or finite (Reynolds, tabulated per L/D)"),
 }
 
 CONTACT = {
