@@ -18,7 +18,6 @@ Oracles:
 from __future__ import annotations
 
 import json
-import math
 import re
 
 import numpy as np
@@ -36,7 +35,7 @@ def test_cycle_window_is_the_last_revolution_by_crank_angle(sense):
     from crankmodal.fatigue.stage import cycle_window
 
     rev_hz, dt = 25.0, 1.0 / (25.0 * 360.0)  # 1 deg steps
-    t = np.arange(0, int(round(0.2 / dt)) + 1) * dt
+    t = np.arange(0, round(0.2 / dt) + 1) * dt
     angle = sense * 2 * np.pi * rev_hz * t % (2 * np.pi)  # wrapped, as a sensor would give it
     sel = cycle_window(angle, 360.0, t, t_min=0.1)
     assert sel.sum() == 361  # 0..360 deg inclusive
@@ -135,7 +134,7 @@ CRANK = {"n_modes": 8, "material": "crank_steel_seed000", "mesh_size": 0.014,
          "fixed_interface_modes": 30}
 
 
-def inertia_only_scene(speed_rpm: float, report: bool = False):
+def inertia_only_scene(speed_rpm: float, report: bool = False, ensemble: int = 1):
     """The seed-000 four-star at ``speed_rpm``, gas and friction off (its loads: the pistons'
     and rods' inertia, ∝ ω²), the crank flexible, one revolution assessed after a 0.05 s ramp
     and one settling revolution."""
@@ -149,7 +148,7 @@ def inertia_only_scene(speed_rpm: float, report: bool = False):
     data = {"mechanism": mech,
             "dynamics": {"machine": "four_star_compressor", "clearances": [], "run_rigid": False,
                          "ramp_time": 0.05, "end_time": 0.05 + 2 * rev_s + 1e-9,
-                         "flexible": {"crank": dict(CRANK)}},
+                         "ensemble": ensemble, "flexible": {"crank": dict(CRANK)}},
             "fatigue": {"body": "crank", "surface_finish": "machined", "size_diameter": 0.045,
                         "reliability": 0.99}}
     if report:
@@ -162,7 +161,8 @@ def test_safety_factors_of_inertia_loads_scale_as_one_over_speed_squared(tmp_pat
     import crankmodal as cm
     from crankmodal.fatigue import FatigueResult
 
-    slow = cm.run_scene(inertia_only_scene(600.0), tmp_path / "600", figures=False)["fatigue"]
+    slow = cm.run_scene(inertia_only_scene(600.0, ensemble=2), tmp_path / "600",
+                        figures=False)["fatigue"]
     fast = cm.run_scene(inertia_only_scene(1200.0, report=True), tmp_path / "1200")["fatigue"]
     ratio = {k: slow["locations"][k]["safety_factor"] / fast["locations"][k]["safety_factor"]
              for k in slow["locations"]}
@@ -184,5 +184,12 @@ def test_safety_factors_of_inertia_loads_scale_as_one_over_speed_squared(tmp_pat
     html = (tmp_path / "1200" / "report.html").read_text(encoding="utf-8")
     assert "Fatigue verdict [fatigue]" in html and worst.replace("_", " ") in html
     assert fast["window"]["cycle_deg"] == 360.0 and fast["window"]["n_samples"] == 361
+    # an ensemble assesses every trajectory; a smooth run's trajectories (started 1e-12 apart)
+    # agree to the integration tolerance (rtol 1e-6 on the modal coordinates: 1e-4 is loose)
+    ens = slow["ensemble"]
+    assert ens["n_trajectories"] == 2 and ens["worst_location"] == [worst, worst]
+    assert ens["min_safety_factor"][0] == slow["min_safety_factor"]
+    assert ens["spread"]["max"] == pytest.approx(ens["spread"]["min"], rel=1e-4)
+    assert "ensemble" not in fast
     saved = json.loads((tmp_path / "1200" / "results.json").read_text())["fatigue"]
     assert saved["worst_location"] == worst and saved["passed"] is True

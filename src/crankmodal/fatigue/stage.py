@@ -177,13 +177,23 @@ def _check_window(p: dict, pd: dict, mp) -> None:
     if not speed:
         return  # a torque drive without a speed: checked on the run's crank angle
     rev_s = 60.0 / float(speed)
-    need = pd["ramp_time"] + rev_s + p["cycles"] * p["cycle_deg"] / 360.0 * rev_s
+    need = settled_from(pd, rev_s) + p["cycles"] * p["cycle_deg"] / 360.0 * rev_s
     if pd["end_time"] < need * (1.0 - 1e-9):
+        after = (f"dynamics.spectrum_start ({pd['spectrum_start']:g} s)"
+                 if pd["spectrum_start"] is not None else
+                 f"the ramp ({pd['ramp_time']:g} s) and one settling revolution")
         raise SceneError(f"dynamics.end_time: {pd['end_time']:g} s holds no {p['cycles']} steady "
-                         f"cycle(s) of {p['cycle_deg']:g} deg for [fatigue] after the ramp "
-                         f"({pd['ramp_time']:g} s) and one settling revolution at "
+                         f"cycle(s) of {p['cycle_deg']:g} deg for [fatigue] after {after} at "
                          f"{float(speed):g} rpm: give end_time >= {need:.4g} s (or fewer "
                          f"fatigue.cycles)")
+
+
+def settled_from(pd: dict, revolution_s: float) -> float:
+    """When the run is steady, s: ``dynamics.spectrum_start`` when given (the results window's
+    start), else the end of the ramp plus one settling revolution."""
+    if pd.get("spectrum_start") is not None:
+        return float(pd["spectrum_start"])
+    return float(pd["ramp_time"]) + revolution_s
 
 
 def _crank_part(pd: dict, spec: dict, table: str):
@@ -365,15 +375,14 @@ def run(p: dict, ctx) -> dict:
     locations = _locations(p, fb, nodes, notes)
     rev_hz = mech.revolution_hz
     span = p["cycle_deg"] * p["cycles"]
-    dp = ctx.params["dynamics"]
-    t_min = dp["ramp_time"] + 1.0 / rev_hz
+    t_min = settled_from(ctx.params["dynamics"], 1.0 / rev_hz)
     sel = cycle_window(hist.crank_angle, span, hist.t, t_min)
     res = _assess(p, body, fb, hist, sel, S, nodes, locations, notes)
     ens = _ensemble(p, body, fb, members, t_min, span, S, nodes, locations, res)
     if mech.system.clearances and ens is None:
-        warn(f"fatigue: the run has clearance joints and one trajectory: its safety factor is "
-             f"one sample of an impacting system, not a result; give dynamics.ensemble >= 3 "
-             f"for the spread over trajectories", notes)
+        warn("fatigue: the run has clearance joints and one trajectory: its safety factor is "
+             "one sample of an impacting system, not a result; give dynamics.ensemble >= 3 "
+             "for the spread over trajectories", notes)
     out = res.to_dict()
     if res.worst_location is not None and \
             out["locations"].get("elsewhere", {}).get("safety_factor", np.inf) \
