@@ -100,6 +100,19 @@ class DynamicsResult:
     ideal_force_direction : dict
         Clearance joint name -> ``(beta, rate)``: direction of the force the ideal pin carries
         there (rad) and its rate (rad/s), over the ideal twin's output times.
+
+    Examples
+    --------
+    A run's output folder read back and a figure redrawn (the stage saved ``dynamics.npz``)::
+
+        import crankmodal as cm
+
+        cm.run_scene(cm.load_scene(cm.scene_path("slider_crank_dynamics")), "out")
+        result = cm.DynamicsResult.load("out/dynamics.npz")
+        peak = result.statistics["main_bearing_force"]["per_rev_peak"]  # N: mean, sem, ...
+        sel = result.window_mask()
+        force = result.history.main_bearing_force[sel]  # (K, 2) N, the results window
+        result.plot_orbits("orbit.png")
     """
 
     history: History
