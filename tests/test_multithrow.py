@@ -415,3 +415,51 @@ def test_torsional_sweep_follows_the_one_mass_resonance_curve_by_order():
         expected = [coeff[n] / abs(k - J * (n * W) ** 2 + 1j * c * n * W) for n in (1, 2)]
         np.testing.assert_allclose(got, expected, rtol=0.01)
     assert np.argmax([a[0] for a in res["amplitude"]]) == 1   # the peak at 955 rpm
+
+
+# ------------------------------------------------- flexible crank on three main journals (slow)
+@pytest.mark.slow
+def test_seed004_flexible_crank_on_three_journals_held_under_constant_pin_loads_is_static(
+        tmp_path, monkeypatch):
+    """Seed 004's reduced two-throw crank (coarse mesh) in a crank train held at cylinder 1's
+    top dead centre (speed 0), constant gas forces 12 and 7 kN (both rods along their axes):
+    the run settles (modal damping 0.2, 0.1 s) to the journal reactions of the static
+    condensation of the same planar body pinned at its three journals and held at its drive
+    ([K -C^T; C 0][q; mu] = [Q; 0]; the body-level FE check of test_crank_bodies ties that
+    condensation to a full FE static solve within 1 %). Measured (damping 0.02, 0.25 s):
+    3937.8 / 13627.6 / 1430.9 N against 3938.7 / 13622.7 / 1438.7 N. The middle journal
+    carries 72 % of the load, which a two-bearing split (journals 1 and 3) cannot give."""
+    from crankmodal.dynamics.flexible.build import crank_body
+    from crankmodal.reduction import parts
+
+    monkeypatch.setenv("CRANKMODAL_CACHE", str(tmp_path))
+    spec = {"fidelity": "simplified", "mesh_size": 0.04, "element_order": 2,
+            "material": "SG 700/2", "fixed_interface_modes": 12}
+    path = parts.reduced_part("multi_bearing_compressor", "crankshaft", spec, n_rods=2)
+    body, roles = crank_body(path, {"damping_ratio": 0.2}, None, 0.06, throws=[1, 2])
+    loads = (12e3, 7e3)
+    arrangement = Arrangement(throw_angles=(0.0, np.pi), cylinder_throws=(0, 1),
+                              bank_angles=(0.0, 0.0))
+    cyls = [Cylinder(axis_angle=np.pi / 2, rod_length=0.24, rod_mass=1e-3, rod_inertia=1e-6,
+                     rod_com=0.08, piston_mass=1e-3, gas_force=(lambda f: lambda psi: f)(f))
+            for f in loads]
+    mech = crank_train(0.06, cyls, 0.0, direction=-1, arrangement=arrangement,
+                       crank_body=body, crank_roles=roles, theta0=np.pi / 2)
+    hist = simulate(mech, 0.1, 1e-3, SolverSettings(method="LSODA", rtol=1e-8, atol=1e-11),
+                    ideal=True, start="undeformed")
+    got = np.array([hist.joint_forces[f"main_{j}"][-1] for j in (1, 2, 3)])
+    q = mech.q0[:body.ndof].copy()
+    q[3:] = 0.0
+    K = np.zeros((body.ndof, body.ndof))
+    K[3:, 3:] = np.diag(body.K)
+    C = np.vstack([body.frame_jacobian(q, m)[:2] for m in roles["mains"]]
+                  + [body.frame_jacobian(q, roles["drive"])[2:3]])
+    Q = sum(body.frame_jacobian(q, p)[:2].T @ np.array([0.0, -f])
+            for p, f in zip(roles["pins"], loads))
+    n, c = body.ndof, len(C)
+    A = np.block([[K, -C.T], [C, np.zeros((c, c))]])
+    mu = np.linalg.solve(A, np.concatenate([Q, np.zeros(c)]))[n:n + 6].reshape(3, 2)
+    # the crank's force on each journal's housing is minus the housing's force on the crank
+    np.testing.assert_allclose(got, -mu, rtol=0, atol=0.01 * sum(loads))
+    np.testing.assert_allclose(got[:, 1], -mu[:, 1], rtol=0.01)
+    assert -got[1, 1] > 0.5 * sum(loads)
