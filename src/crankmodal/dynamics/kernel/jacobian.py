@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .compiled import DIAG, N_AUX, assemble, finish
+from .compiled import DIAG, N_AUX, assemble, finish, flush_if_changed
 
 #: columns of the kernel's clearance diagnostics
 N_DIAG = len(DIAG)
@@ -261,41 +261,14 @@ def jacobian_for(sysm, method: str, v_impact, atol, rtol) -> dict:
 
 
 def _flush_if_dependencies_changed() -> bool:
-    """Flush this module's Numba cache when the kernel it calls changed.
-
-    Numba keys a cached function on its own file only (numba issue #1833): the functions here
-    call :func:`~.compiled.assemble` and :func:`~.compiled.finish`, which call the laws of
-    ``clearance.py``, ``lubrication.py`` and ``reynolds.py``. A stamp of those four files kept
-    beside the cache decides (as :mod:`.compiled` does for its own); returns whether it flushed.
-    """
-    import hashlib
-    from pathlib import Path
-
+    """This module's cached Jacobian calls :func:`~.compiled.assemble` and
+    :func:`~.compiled.finish` and what they call (numba issue #1833)."""
     from ..laws import lubrication, reynolds
-    from ..model import clearance
+    from ..model import clearance, joints
     from . import compiled
 
-    digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes()
-                                     for m in (compiled, clearance, lubrication,
-                                               reynolds))).hexdigest()
-    cached = [f for f in (_lu, _lu_solve, jacobian) if f._cache is not None]
-    try:
-        stamp = Path(cached[0]._cache._cache_path) / "jacobian.deps"
-    except (IndexError, AttributeError):  # no cached function, or numba's internals moved
-        return False
-    try:
-        if stamp.read_text() == digest:
-            return False
-    except OSError:
-        pass
-    for f in cached:
-        f._cache.flush()
-    try:
-        stamp.parent.mkdir(parents=True, exist_ok=True)
-        stamp.write_text(digest)
-    except OSError:
-        pass  # a read-only cache: compiled again next time, never stale
-    return True
+    return flush_if_changed(globals(), __name__,
+                            (compiled, clearance, lubrication, reynolds, joints))
 
 
 _flush_if_dependencies_changed()
