@@ -193,3 +193,16 @@ def test_safety_factors_of_inertia_loads_scale_as_one_over_speed_squared(tmp_pat
     assert "ensemble" not in fast
     saved = json.loads((tmp_path / "1200" / "results.json").read_text())["fatigue"]
     assert saved["worst_location"] == worst and saved["passed"] is True
+
+
+def test_material_of_other_elastic_constants_than_the_body_is_warned():
+    from dataclasses import replace
+
+    from crankmodal.fatigue.stage import material_mismatch
+    from crankmodal.fem.materials import material
+
+    body = material("crank_steel_seed000")
+    assert material_mismatch(replace(body, fatigue_strength=4e8), body.name) is None
+    text = material_mismatch(replace(body, E=1.76e11, rho=7200.0), body.name)
+    assert "in E, rho:" in text and "strengths only" in text
+    assert material_mismatch(body, "a custom material") is None

@@ -151,6 +151,25 @@ def _material(scene, spec: dict, fb, table: str):
     return mat
 
 
+def material_mismatch(mat, body_material) -> str | None:
+    """A warning when the verdict's material (``[material]``) is not elastically the one the
+    body's stress modes were computed with (its library material ``body_material``)."""
+    from ..errors import ParameterError
+    from ..fem.materials import material
+
+    try:
+        ref = material(str(body_material))
+    except ParameterError:
+        return None  # not a library material: nothing to compare with
+    diff = [k for k in ("E", "nu", "rho")
+            if not math.isclose(getattr(mat, k), getattr(ref, k), rel_tol=1e-9)]
+    if not diff:
+        return None
+    return (f"fatigue: [material] ({mat.name}) differs from the body's material "
+            f"({ref.name}) in {', '.join(diff)}: the stress modes were computed with the "
+            f"body's; [material] gives the strengths only")
+
+
 def _mechanism_params(scene):
     raw = None if scene is None else scene.sections.get("mechanism")
     if raw is None:
@@ -365,10 +384,9 @@ def run(p: dict, ctx) -> dict:
         raise SceneError(f"fatigue.body: the reduced body of {p['body']!r} "
                          f"({body.info.get('file')}) holds no stress modes")
     notes: list[str] = []
-    if p["material"].name != (fb.info or {}).get("material", p["material"].name):
-        warn(f"fatigue: the strengths are [material]'s ({p['material'].name}), the stress modes "
-             f"were computed with the body's material ({fb.info['material']}): its E, nu and rho "
-             "set the stresses", notes)
+    text = material_mismatch(p["material"], (fb.info or {}).get("material"))
+    if text:
+        warn(text, notes)
     S = np.asarray(fb.stress_modes)[:, :, np.asarray(body.info["mode_columns"], int)]
     cells = fb.mesh_cells
     nodes = surface_nodes(cells) if p["surface_only"] and cells is not None else None
