@@ -23,8 +23,9 @@ from .signals import Spectrum
 
 FORMAT = "crankmodal-dynamics"
 VERSION = 1
-#: the prefixes of the histories in the file: the run with clearance, its twins
-PREFIXES = {"history": "", "ideal": "ideal_", "rigid": "rigid_"}
+#: the prefixes of the histories in the file (in the order written): the run with clearance,
+#: its twins
+PREFIXES = {"history": "", "rigid": "rigid_", "ideal": "ideal_"}
 
 
 @dataclass(frozen=True)

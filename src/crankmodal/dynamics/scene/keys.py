@@ -11,9 +11,9 @@ import numpy as np
 from ...errors import SceneError
 from ...schema import Field, validate
 from ..laws import contact
-from ..model.clearance import RULES as CLEARANCE_RULES
-from ..run.rules import MAX_OUTPUT_SAMPLES, METHODS, RUN  # noqa: F401 (METHODS: public here)
-from ..run.rules import SOLVER as SOLVER_RULES
+from ..model import clearance as _clearance  # the core's rules (a module: not a key table)
+from ..run import rules as _rules
+from ..run.rules import MAX_OUTPUT_SAMPLES, METHODS  # noqa: F401 (METHODS: public here)
 from . import trains as _trains
 
 MECHANISMS = ("slider_crank", "four_star", "four_bar")
@@ -33,8 +33,8 @@ SCHEMA = {
                        ge=0.0),
     "drive_torque": Field("float", None, "N m; if given the speed is free and this torque drives"),
     "initial_angle_deg": Field("float", 0.0, "initial crank angle, deg from the x axis"),
-    "end_time": RUN["end_time"],
-    "output_step": RUN["output_step"],
+    "end_time": _rules.RUN["end_time"],
+    "output_step": _rules.RUN["output_step"],
     "spectrum_start": Field("float", None, "start of the spectrum window, s (default: after the "
                             "ramp and one revolution)", ge=0.0),
     "gravity": Field("floats", [0.0, 0.0], "gravity vector in the plane, m/s^2", length=2),
@@ -44,7 +44,7 @@ SCHEMA = {
     "gas_cycle_deg": Field("float", 360.0, "360 (compressor, two-stroke) or 720 (four-stroke)",
                            check=lambda v: None if v in (360.0, 720.0) else "must be 360 or 720"),
     "ring_friction_n": Field("float", 0.0, "piston ring friction force, N", ge=0.0),
-    "energy_tolerance": RUN["energy_tolerance"],
+    "energy_tolerance": _rules.RUN["energy_tolerance"],
     "run_ideal": Field("bool", True, "also run the ideal-joint twin (reference, contact loss)"),
     "crank_train": Field("table", {}, "slider-crank / four-star geometry and masses"),
     "four_bar": Field("table", {}, "four-bar geometry and masses"),
@@ -103,17 +103,17 @@ CLEARANCE = {
     "joint": Field("str", "big_end_1", "joint name: main, big_end_i, small_end_i (crank trains); "
                    "A, B, C, D (four-bar)"),
     # bounds: the core's (ClearanceSpec's RULES); defaults and docs: the scene's
-    "clearance": replace(CLEARANCE_RULES["clearance"], default=1e-4, doc="radial clearance, m"),
-    "journal_radius": replace(CLEARANCE_RULES["journal_radius"], default=0.02, doc="m"),
-    "clearance_major": replace(CLEARANCE_RULES["clearance_major"], doc="worn bearing (seed "
+    "clearance": replace(_clearance.RULES["clearance"], default=1e-4, doc="radial clearance, m"),
+    "journal_radius": replace(_clearance.RULES["journal_radius"], default=0.02, doc="m"),
+    "clearance_major": replace(_clearance.RULES["clearance_major"], doc="worn bearing (seed "
                                "003): radial clearance along the major axis of the elliptical "
                                "bore, m (clearance is the minor one)"),
     "wear_angle_deg": Field("float", 0.0, "major axis of the worn bore from the bearing body's "
                             "axis (rod axis for big and small ends), deg"),
-    "viscosity": replace(CLEARANCE_RULES["viscosity"], doc="lubricant dynamic viscosity, Pa s: "
+    "viscosity": replace(_clearance.RULES["viscosity"], doc="lubricant dynamic viscosity, Pa s: "
                          "adds the short-bearing (Ocvirk) film force"),
-    "bearing_length": CLEARANCE_RULES["bearing_length"],
-    "film_model": replace(CLEARANCE_RULES["film_model"], doc="film force with viscosity: short "
+    "bearing_length": _clearance.RULES["bearing_length"],
+    "film_model": replace(_clearance.RULES["film_model"], doc="film force with viscosity: short "
                           "(Ocvirk) or finite (Reynolds, tabulated per L/D)"),
 }
 
@@ -143,12 +143,12 @@ FRICTION = {
 }
 
 SOLVER = {  # the integrator's rules from the core (run.rules); the step bound in degrees here
-    "method": SOLVER_RULES["method"],
-    "rtol": SOLVER_RULES["rtol"],
-    "atol": SOLVER_RULES["atol"],
+    "method": _rules.SOLVER["method"],
+    "rtol": _rules.SOLVER["rtol"],
+    "atol": _rules.SOLVER["atol"],
     "max_step_deg": Field("float", 2.0, "largest step, deg of crank", gt=0.0, le=90.0),
-    "max_rhs_evals": SOLVER_RULES["max_rhs_evals"],
-    "baumgarte": SOLVER_RULES["baumgarte"],
+    "max_rhs_evals": _rules.SOLVER["max_rhs_evals"],
+    "baumgarte": _rules.SOLVER["baumgarte"],
     "study_rtols": Field("floats", [], "tolerances of the error-against-run-time study", gt=0.0,
                          lt=1.0),
 }
@@ -163,7 +163,7 @@ FLEXIBLE = {
                      "file = \"...npz\" or bar = [width, thickness]"),
     "rocker": Field("table", {}, "four-bar: the rocker D-C as a flexible body (absent: rigid): "
                     "file = \"...npz\" or bar = [width, thickness]"),
-    "start": RUN["start"],
+    "start": _rules.RUN["start"],
 }
 
 FLEX_BODY = {
