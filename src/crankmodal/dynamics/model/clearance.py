@@ -83,7 +83,7 @@ class ClearanceSpec:
     clearance: float
     journal_radius: float
     normal: laws.NormalLaw
-    friction: laws.FrictionLaw = laws.NoFriction()
+    friction: laws.FrictionLaw = field(default_factory=laws.NoFriction)
     v_impact_min: float = 1e-3
     clearance_major: float | None = None
     wear_angle: float = 0.0
@@ -185,7 +185,7 @@ class ClearanceJoint:
     journal_radius: float
     law: laws.NormalLaw = None
     law_params: dict | None = field(default=None, repr=False)
-    friction: laws.FrictionLaw = laws.NoFriction()
+    friction: laws.FrictionLaw = field(default_factory=laws.NoFriction)
     friction_params: dict | None = field(default=None, repr=False)
     v_impact_min: float = 1e-3
     clearance_major: float | None = None
