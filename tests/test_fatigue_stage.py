@@ -206,3 +206,30 @@ def test_material_of_other_elastic_constants_than_the_body_is_warned():
     text = material_mismatch(replace(body, E=1.76e11, rho=7200.0), body.name)
     assert "in E, rho:" in text and "strengths only" in text
     assert material_mismatch(body, "a custom material") is None
+
+
+@pytest.mark.slow
+def test_an_impacting_run_reports_the_spread_over_its_trajectories(tmp_path):
+    """The four-star with its seed clearance in big end 1 (impacting): every trajectory's cycle
+    is assessed and the verdict holds for the lowest; one impacting trajectory is warned."""
+    import crankmodal as cm
+
+    def scene(ensemble):
+        return cm.scene_from_dict(
+            {"mechanism": {"machine": "four_star_compressor"},
+             "dynamics": {"machine": "four_star_compressor", "end_time": 0.2, "run_rigid": False,
+                          "run_ideal": False, "ensemble": ensemble,
+                          "flexible": {"crank": dict(CRANK)}},
+             "fatigue": {"body": "crank", "required_safety_factor": 5.3}}, name="impacting")
+
+    res = cm.run_scene(scene(2), tmp_path / "ens", figures=False)["fatigue"]
+    ens = res["ensemble"]
+    n = ens["min_safety_factor"]
+    assert ens["n_trajectories"] == 2 and n[0] == res["min_safety_factor"]
+    assert ens["spread"]["min"] == min(n) and ens["spread"]["max"] == max(n)
+    assert res["passed"] is (min(n) >= 5.3)
+    assert "over 2 trajectories the lowest ranges" in res["summary"]
+    assert not any("one trajectory" in w for w in res["warnings"])
+    one = cm.run_scene(scene(1), tmp_path / "one", figures=False)["fatigue"]
+    assert "ensemble" not in one
+    assert any("clearance joints and one trajectory" in w for w in one["warnings"])
