@@ -62,10 +62,10 @@ def test_python_api_simulate_refuses_damping_1e9_before_integrating(monkeypatch)
     monkeypatch.setattr(analysis, "integrate", no_integration)
     with pytest.raises(ParameterError) as exc:
         analysis.simulate(mech, t_end, dt, settings)
-    assert exc.value.argument == "contact.damping"
-    assert "contact.damping = 1e+09" in exc.value.text and "2000000" in exc.value.text
+    assert exc.value.argument == "law.damping"  # the core's name; a scene's: contact.damping
+    assert "law.damping = 1e+09" in exc.value.text and "2000000" in exc.value.text
     # the estimate: IMPACT's dashpot at the static penetration of the inertia load m w^2 r
-    (ts,) = [s for s in budget._contact_scales(mech) if s.key == "contact.damping"]
+    (ts,) = [s for s in budget._contact_scales(mech) if s.key == "law.damping"]
     law, m = ts.scale.law, ts.scale.mass
     load = m * (2 * np.pi * mech.revolution_hz) ** 2 * 0.035  # r = 35 mm
     d = (load / law.stiffness) ** (1 / 1.5)
@@ -123,7 +123,7 @@ def test_estimate_is_the_stability_step_of_the_oscillator_or_the_dashpot(damping
     s = SolverSettings(method="RK45", max_step=1e-3)
     est = budget.estimate(mech, 0.01, s)
     assert est.evaluations == pytest.approx(6 * 0.01 / 1e-3 + 6 * 0.01 / step, rel=1e-9)
-    assert est.stiff.key == ("contact.damping" if damping > 1e3 else "contact.stiffness")
+    assert est.stiff.key == ("law.damping" if damping > 1e3 else "law.stiffness")
     assert est.wall_time == pytest.approx(est.evaluations * est.cost_per_eval, rel=1e-12)
     assert budget.estimate(mech, 0.01, SolverSettings(method="Radau")).evaluations is None
 
@@ -133,7 +133,7 @@ def test_over_three_times_the_budget_is_refused_and_over_a_fifth_is_warned():
     with pytest.raises(ParameterError) as exc:
         budget.check(mech, 0.01, SolverSettings(method="RK45", max_step=1e-3,
                                                 max_rhs_evals=40_000))
-    assert exc.value.argument == "contact.damping" and "must be <=" in exc.value.text
+    assert exc.value.argument == "law.damping" and "must be <=" in exc.value.text
     # 'must be <= c' gives a step that fits the budget: 2 m / c >= 6 t / (budget - smooth)
     c_max = float(exc.value.text.split("must be <= ")[1].split(" ")[0])
     assert 2 * 2.0 / c_max == pytest.approx(6 * 0.01 / (40_000 - 60), rel=1e-2)

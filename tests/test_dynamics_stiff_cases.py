@@ -72,5 +72,5 @@ def test_soft_contact_is_refused_with_advice_to_raise_the_stiffness():
 
 def test_explicit_solver_on_stiff_contact_stops_within_its_budget_naming_the_stiffness():
     # refused before the run since issue 27 #4 (ParameterError: 2100 evaluations estimated)
-    with pytest.raises((NumericalError, ParameterError), match="contact.stiffness = 1e\\+12.*Radau"):
+    with pytest.raises((NumericalError, ParameterError), match="law.stiffness = 1e\\+12.*Radau"):
         _run(1e12, 1e-4, 1480, 0.5, False, method="RK45", budget=300)

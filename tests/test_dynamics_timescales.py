@@ -59,8 +59,9 @@ def test_linear_contact_period_and_damping_time_and_the_key_they_name():
     # the stiffness limits; c = 1e7 N s/m: m / c = 2e-7 s, step 4e-7 s, the damping limits
     from types import SimpleNamespace
 
-    for c, key, step in ((10.0, "contact.stiffness", 2 * np.sqrt(2.0 / 1e8)),
-                         (1e7, "contact.damping", 4e-7)):
+    # the core names the law's parameter; a scene names contact.stiffness / contact.damping
+    for c, key, step in ((10.0, "law.stiffness", 2 * np.sqrt(2.0 / 1e8)),
+                         (1e7, "law.damping", 4e-7)):
         sysm, cj = _journal(2.0, params={"stiffness": 1e8, "damping": c})
         mech = SimpleNamespace(system=sysm, q0=np.zeros(3), qd0=np.zeros(3), revolution_hz=0.0,
                                crank=cj.journal)
@@ -85,7 +86,7 @@ def test_the_time_scales_ask_the_joint_law_object():
     (ts,) = timescales.joint_time_scales(mech)
     assert ts.load == 1.0  # no gas force, no speed: the floor of 1 N
     assert ts.k_lin == pytest.approx(1.5 * 1e10**(2 / 3) * 1.0**(1 / 3), rel=1e-12)
-    assert ts.damping is None and ts.damping_set is None and ts.key == "contact.stiffness"
+    assert ts.damping is None and ts.damping_set is None and ts.key == "law.stiffness"
     assert cj.normal.tangent_stiffness(1000.0) == pytest.approx(1.5 * 1e10**(2 / 3) * 10.0)
 
 
@@ -94,7 +95,7 @@ def test_advice_never_names_the_method_in_use(method):
     # issue 18 #6: a run with LSODA was advised "use LSODA or Radau"
     sysm, _ = _journal(2.0)
     text = _stiffness_advice(sysm, SolverSettings(method=method))
-    assert f"'{method}'" not in text and "solver.method = '" in text
+    assert f"'{method}'" not in text and "settings.method = '" in text
 
 
 def test_over_budget_advice_names_the_damping_when_it_limits_the_step():
@@ -108,7 +109,7 @@ def test_over_budget_advice_names_the_damping_when_it_limits_the_step():
     from crankmodal.errors import NumericalError
     with pytest.raises(NumericalError) as exc:
         integrate(sysm, np.zeros(3), np.array([0.5, 0.0, 0.0]), 0.01, None, s)
-    assert "lower contact.damping" in str(exc.value) and "contact.damping = 1e+06" in str(exc.value)
+    assert "lower law.damping" in str(exc.value) and "law.damping = 1e+06" in str(exc.value)
     assert "'RK45'" not in str(exc.value)
 
 

@@ -66,7 +66,7 @@ GUARD_MIN_EVALS = 1000
 class Stiff:
     """One time scale that bounds an explicit step."""
 
-    key: str        # key under [dynamics] to change (contact.stiffness, contact.damping, ...)
+    key: str        # what to change (law.stiffness, law.damping, flexible.<body>)
     step: float     # largest step it allows, s
     what: str       # what it is, with its numbers, for messages
     scale: object = None  # the TimeScale of :mod:`.timescales` (contact) or None (a mode)
@@ -75,7 +75,7 @@ class Stiff:
         """What to change so the step reaches ``h_needed`` s."""
         if self.scale is None:
             return (f"keep fewer modes ({self.key}.n_modes, or cutoff_hz below "
-                    f"{2.0 / h_needed / (2.0 * np.pi):.3g} Hz) or use solver.method = 'Radau'")
+                    f"{2.0 / h_needed / (2.0 * np.pi):.3g} Hz) or use settings.method = 'Radau'")
         from .timescales import _allowed
 
         return f"{self.key} must be {_allowed(self.scale, h_needed)} for this budget"
@@ -194,7 +194,7 @@ def check(mech, t_end: float, settings) -> tuple[RunEstimate, list[str]]:
     Raises
     ------
     ParameterError
-        Naming the key responsible (``contact.stiffness``, ``contact.damping``,
+        Naming what is responsible (``law.stiffness``, ``law.damping``,
         ``flexible.<body>``) when the estimate exceeds
         :data:`REFUSE_FACTOR` times ``max_rhs_evals``: known from the input alone, before any
         integration, so refused as bad input (a scene relabels it ``dynamics.<key>``).
@@ -216,19 +216,19 @@ def check(mech, t_end: float, settings) -> tuple[RunEstimate, list[str]]:
         h_needed = per * t_end / max(budget - est.smooth_evaluations, 1.0)
         raise ParameterError(
             stiff.key,
-            f"{stiff.what} limits solver.method = {settings.method!r} to steps of "
-            f"{stiff.step:.2g} s: about {n:.3g} right-hand-side evaluations over end_time = "
+            f"{stiff.what} limits settings.method = {settings.method!r} to steps of "
+            f"{stiff.step:.2g} s: about {n:.3g} right-hand-side evaluations over t_end = "
             f"{t_end:g} s (about {_seconds(n * est.cost_per_eval)}), {n / budget:.3g} times "
-            f"solver.max_rhs_evals = {budget}; {stiff.advice(h_needed)} (or raise "
-            f"solver.max_rhs_evals, shorten end_time, or use solver.method = 'Radau')")
+            f"settings.max_rhs_evals = {budget}; {stiff.advice(h_needed)} (or raise "
+            f"settings.max_rhs_evals, shorten t_end, or use settings.method = 'Radau')")
     warnings = []
     if est.evaluations > WARN_FRACTION * budget:
         s = est.stiff
-        why = f"{s.what} limits the step to {s.step:.2g} s" if s else "solver.max_step"
+        why = f"{s.what} limits the step to {s.step:.2g} s" if s else "settings.max_step"
         warnings.append(
-            f"dynamics: {why} with solver.method = {settings.method!r}: about "
+            f"dynamics: {why} with settings.method = {settings.method!r}: about "
             f"{est.evaluations:.3g} right-hand-side evaluations ({100 * est.evaluations / budget:.0f} "
-            f"% of solver.max_rhs_evals), estimated wall time {_seconds(est.wall_time)}; "
+            f"% of settings.max_rhs_evals), estimated wall time {_seconds(est.wall_time)}; "
             f"the run may stop at its budget")
     mech.system._budget_checked = (memo_key, est)
     return est, warnings

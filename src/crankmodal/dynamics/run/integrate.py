@@ -45,8 +45,8 @@ class SolverSettings:
         Budget of right-hand-side evaluations; beyond it the run stops with a NumericalError.
     time_scales : tuple of TimeScale
         The clearance joints' contact time scales (:mod:`.timescales`), if estimated: the advice
-        of a failed run then names the key that limits the step (``contact.damping`` or
-        ``contact.stiffness``).
+        of a failed run then names the law parameter that limits the step (``law.damping`` or
+        ``law.stiffness``).
 
     Raises
     ------
@@ -212,8 +212,8 @@ def _stiffness_advice(sysm, settings: SolverSettings | None = None) -> str:
         if mode is None:
             return "tighten nothing: ideal joints only; check the speed and masses"
         body, hz = mode
-        change = ("raise solver.max_rhs_evals" if method in ("Radau", "BDF")
-                  else "use solver.method = 'Radau'")
+        change = ("raise settings.max_rhs_evals" if method in ("Radau", "BDF")
+                  else "use settings.method = 'Radau'")
         return (f"ideal joints only: the stiffest kept mode ({hz:.4g} Hz of {body!r}) is the "
                 f"stiff part: {change} or keep fewer modes of {body!r} (n_modes / cutoff_hz of "
                 f"its [dynamics.flexible] table)")
@@ -223,13 +223,13 @@ def _stiffness_advice(sysm, settings: SolverSettings | None = None) -> str:
 
         ts = responsible(settings.time_scales)
         return (f"joint {ts.joint!r} limits the step to {ts.step:.2g} s through "
-                f"{ts.describe()}: lower {ts.key}, use solver.method = {other}, or raise "
-                f"solver.max_rhs_evals")
+                f"{ts.describe()}: lower {ts.key}, use settings.method = {other}, or raise "
+                f"settings.max_rhs_evals")
     cj = sysm.clearances[0]
     K = getattr(cj.law, "stiffness", float("nan"))
-    return (f"the contact of joint {cj.name!r} is the stiff part (contact.stiffness = {K:.3g}, "
+    return (f"the contact of joint {cj.name!r} is the stiff part (law.stiffness = {K:.3g}, "
             f"clearance = {cj.clearance:.3g} m) or its friction near stiction: lower "
-            f"contact.stiffness, use solver.method = {other}, or raise solver.max_rhs_evals")
+            f"law.stiffness, use settings.method = {other}, or raise settings.max_rhs_evals")
 
 
 def _per_step(settings) -> float:
@@ -272,7 +272,7 @@ def _failure(exc, sysm, settings, t: float) -> NumericalError:
             f"integration stopped at t = {exc.t:.6g} s after {sysm.nfev} right-hand-side "
             f"evaluations: at its present {exc.rate:.3g} per simulated second (mean step "
             f"{_per_step(settings) / exc.rate:.2g} s) the run needs about {exc.projected:.3g}, "
-            f"over solver.max_rhs_evals = {settings.max_rhs_evals}; "
+            f"over settings.max_rhs_evals = {settings.max_rhs_evals}; "
             f"{regime_note(_per_step(settings) / exc.rate, settings.time_scales)}{advice}")
     if isinstance(exc, NonFinite):
         return NumericalError(f"non-finite accelerations at t = {exc.t:.6g} s; {advice}")

@@ -10,7 +10,9 @@ axes for Dormand-Prince RK45); with the margin its error control keeps, a step o
 evaluations per step, bounds the right-hand-side evaluations from below *if the joint is in
 contact the whole time* (the big ends of the four-star and slider-crank scenes are, 80-100 % of
 it, at their loads); :mod:`.budget` turns it into the run's estimate, refuses a run whose
-estimate exceeds ``solver.max_rhs_evals`` and names the key whose time scale is the shorter.
+estimate exceeds ``settings.max_rhs_evals`` and names the law parameter whose time scale is the
+shorter (``law.stiffness`` or ``law.damping``: the joint law's arguments; a scene's stage names
+its ``contact.stiffness`` / ``contact.damping`` keys).
 
 Effective mass: ``1 / lambda_max`` of the 2x2 relative mobility of journal and bearing centres
 (the acceleration of one against the other per unit force pair, through the mass matrix and
@@ -53,19 +55,19 @@ class TimeScale:
 
     @property
     def stiffness(self) -> float:
-        """The law's stiffness parameter (``contact.stiffness``)."""
+        """The law's stiffness parameter (``law.stiffness``)."""
         return self.law.stiffness
 
     @property
     def damping_set(self) -> float | None:
-        """``contact.damping`` as given, N s/m (None: the law has no dashpot)."""
+        """``law.damping`` as given, N s/m (None: the law has no dashpot)."""
         return self.law.dashpot_setting
 
     @property
     def firm(self) -> bool:
         """Whether the estimate is firm enough to refuse a run: not for a damping that depends
         on the penetration the run reaches (``impact``'s, :meth:`NormalLaw.dashpot`)."""
-        return not (self.key == "contact.damping" and self.law.dashpot_varies)
+        return not (self.key == "law.damping" and self.law.dashpot_varies)
 
     @property
     def step(self) -> float:
@@ -77,20 +79,21 @@ class TimeScale:
 
     @property
     def key(self) -> str:
-        """The scene key whose time scale is the shorter: ``contact.damping`` or ``stiffness``."""
+        """The law parameter whose time scale is the shorter: ``law.damping`` or
+        ``law.stiffness`` (a scene names its key)."""
         if self.damping_time is not None and 2.0 * self.damping_time < self.period / np.pi:
-            return "contact.damping"
-        return "contact.stiffness"
+            return "law.damping"
+        return "law.stiffness"
 
     def describe(self) -> str:
-        """``contact.<key> = value (its time scale)``, for messages."""
-        if self.key == "contact.damping":
+        """``law.<parameter> = value (its time scale)``, for messages."""
+        if self.key == "law.damping":
             c = f"{self.damping:.3g} N s/m"
             if self.law.dashpot_varies:  # impact's STEP ramp: the value set is the full one
                 c = f"{self.damping_set:.3g} N s/m ({self.damping:.3g} at the static penetration)"
-            return (f"contact.damping = {c} (damping time m/c = {self.damping_time:.2g} s with "
+            return (f"law.damping = {c} (damping time m/c = {self.damping_time:.2g} s with "
                     f"the effective mass {self.mass:.3g} kg)")
-        return (f"contact.stiffness = {self.stiffness:.3g} (contact period {self.period:.2g} s "
+        return (f"law.stiffness = {self.stiffness:.3g} (contact period {self.period:.2g} s "
                 f"with the effective mass {self.mass:.3g} kg at {self.load:.3g} N)")
 
 
@@ -178,7 +181,7 @@ def estimated_evals(ts: TimeScale, t_end: float, method: str) -> float | None:
 
 def _allowed(ts: TimeScale, h_needed: float) -> str:
     """The largest value of the responsible key that keeps the step above ``h_needed``."""
-    if ts.key == "contact.damping":
+    if ts.key == "law.damping":
         # the dashpot at the load scales with the value set (IMPACT's STEP ramp: c_max s(delta))
         scale = ts.damping_set / ts.damping if ts.damping_set else 1.0
         return f"<= {2.0 * ts.mass / h_needed * scale:.3g} N s/m"

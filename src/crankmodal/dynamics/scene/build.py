@@ -19,14 +19,12 @@ from .keys import cylinder_angles
 NORMAL_LAW_KEYS = {"stiffness": "stiffness", "exponent": "exponent", "damping": "damping",
                    "penetration": "penetration", "restitution": "restitution",
                    "radial_clearance": "stiffness", "law": "law"}
-#: what the core's advice names (the law's and the solver settings' arguments) -> the scene key
-#: a scene's user changes (:func:`scene_words`)
-ADVICE_KEYS = {"law.stiffness": "dynamics.contact.stiffness",
-               "law.damping": "dynamics.contact.damping",
-               "settings.rtol": "dynamics.solver.rtol", "settings.atol": "dynamics.solver.atol",
-               "settings.max_step": "dynamics.solver.max_step_deg",
-               "settings.method": "dynamics.solver.method",
-               "settings.max_rhs_evals": "dynamics.solver.max_rhs_evals"}
+#: what the core's advice names (the law's and the solver settings' arguments, simulate's
+#: t_end) -> the key under ``[dynamics]`` a scene's user changes (:func:`scene_words`)
+ADVICE_KEYS = {"law.stiffness": "contact.stiffness", "law.damping": "contact.damping",
+               "settings.rtol": "solver.rtol", "settings.atol": "solver.atol",
+               "settings.max_step": "solver.max_step_deg", "settings.method": "solver.method",
+               "settings.max_rhs_evals": "solver.max_rhs_evals", "t_end": "end_time"}
 #: :func:`..results.validity.penetration_warning`'s words in a scene
 CONTACT_WORDS = {"stiffness": "dynamics.contact.stiffness",
                  "johnson_cylinder": "dynamics.contact.law = 'johnson_cylinder'"}
@@ -42,19 +40,24 @@ def relabel(text: str, keys: dict = ADVICE_KEYS) -> str:
 
 
 class scene_words:
-    """Re-raise a :class:`~crankmodal.errors.NumericalError` of the block with the arguments
-    its advice names replaced by their scene keys (:data:`ADVICE_KEYS`)."""
+    """Re-raise a :class:`~crankmodal.errors.NumericalError` or
+    :class:`~crankmodal.errors.SceneError` of the block with the arguments its advice names
+    replaced by their scene keys (:data:`ADVICE_KEYS`; a SceneError's leading key kept)."""
 
     def __enter__(self):
         return self
 
     def __exit__(self, kind, exc, tb):
-        from ...errors import NumericalError
+        from ...errors import NumericalError, SceneError
 
         if isinstance(exc, NumericalError):
             text = relabel(str(exc))
             if text != str(exc):
                 raise NumericalError(text) from None
+        elif isinstance(exc, SceneError):
+            key, sep, text = str(exc).partition(": ")
+            if relabel(text) != text:
+                raise SceneError(key + sep + relabel(text)) from None
         return False
 
 

@@ -177,7 +177,6 @@ def run(params: dict, ctx) -> dict:
     """Run the ``[dynamics]`` section: build, integrate (with the ideal and rigid twins),
     summarise, draw and save; returns the results.json entry (see :class:`DynamicsResult`)."""
     from ...errors import warn
-
     from .build import scene_words
 
     p = params
@@ -216,7 +215,7 @@ def _model(p: dict, ctx) -> _Model:
     from ...errors import scene_keys, warn
     from ..run import timescales
     from ..run.budget import check as check_budget
-    from .build import build_mechanism, solver_settings
+    from .build import build_mechanism, relabel, scene_words, solver_settings
     from .keys import flexible_keys
 
     bodies = None
@@ -237,9 +236,11 @@ def _model(p: dict, ctx) -> _Model:
 
         for text in truncation_warnings(p, bodies):
             warn(text, into=model.warnings)
-    with scene_keys("dynamics"):  # refuse what cannot finish (contact.damping: ... -> dynamics.)
+    # refuse what cannot finish: the core names the law's parameter (law.damping), the scene
+    # its key (dynamics.contact.damping), in the advice too
+    with scene_words(), scene_keys("dynamics", {"law": "contact"}):
         for text in check_budget(mech, model.t_end, settings)[1]:
-            warn(text, into=model.warnings)
+            warn(relabel(text), into=model.warnings)
     mech.start = p["flexible"]["start"]  # simulate() leaves an "undeformed" start as built
     if bodies is not None and p["flexible"]["start"] == "quasi_static":
         model.start_info = mech.start_quasi_static()  # on the ideal-joint twin, as simulate() does
