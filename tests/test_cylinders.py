@@ -11,7 +11,6 @@ import pytest
 from crankmodal import part
 from crankmodal.dynamics.model.bridge import cylinders_from_mechanism
 from crankmodal.dynamics.model.mechanisms import Cylinder
-from crankmodal.errors import ParameterError
 from crankmodal.mechanism import machine as mm
 
 

@@ -277,9 +277,9 @@ SCENES = __import__("pathlib").Path(__file__).resolve().parents[1] / "scenes"
 
 
 def _run(scene, out):
-    return subprocess.run([sys.executable, "-c", "import sys; from crankmodal.cli import main; "
-                           "sys.exit(main())", "run", str(scene), "--out", str(out)],
-                          capture_output=True, text=True, timeout=900)
+    code = "import sys; from crankmodal.cli import main; sys.exit(main())"
+    return subprocess.run([sys.executable, "-c", code, "run", str(scene), "--out", str(out)],
+                          capture_output=True, text=True, timeout=900, check=False)
 
 
 @pytest.mark.parametrize("change, key", [
@@ -440,9 +440,11 @@ def test_seed004_flexible_crank_on_three_journals_held_under_constant_pin_loads_
     loads = (12e3, 7e3)
     arrangement = Arrangement(throw_angles=(0.0, np.pi), cylinder_throws=(0, 1),
                               bank_angles=(0.0, 0.0))
+    def constant(force):
+        return lambda psi: force
+
     cyls = [Cylinder(axis_angle=np.pi / 2, rod_length=0.24, rod_mass=1e-3, rod_inertia=1e-6,
-                     rod_com=0.08, piston_mass=1e-3, gas_force=(lambda f: lambda psi: f)(f))
-            for f in loads]
+                     rod_com=0.08, piston_mass=1e-3, gas_force=constant(f)) for f in loads]
     mech = crank_train(0.06, cyls, 0.0, direction=-1, arrangement=arrangement,
                        crank_body=body, crank_roles=roles, theta0=np.pi / 2)
     hist = simulate(mech, 0.1, 1e-3, SolverSettings(method="LSODA", rtol=1e-8, atol=1e-11),

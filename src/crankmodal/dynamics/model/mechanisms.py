@@ -507,13 +507,15 @@ def crank_train(crank_radius, cylinders, speed_rpm, crank_mass=0.0, crank_inerti
         None: prescribed speed. A number: constant torque (N m) with the speed free (put the
         flywheel into ``crank_inertia``).
     clearances : dict, optional
-        ``{joint_name: {"clearance": m, "journal_radius": m, "contact": {overrides}}}``, for a
-        worn (elliptical) bore also ``clearance_major`` (m) and ``wear_angle`` (rad), for a
-        lubricated one ``viscosity`` (Pa s) and ``bearing_length`` (m);
-        joints are ``main``,
-        ``big_end_<i>``, ``small_end_<i>`` (i from 1).
+        ``{joint_name: ClearanceSpec}`` (:class:`~.clearance.ClearanceSpec`: the bore, the
+        journal, the law objects, the film); joints are ``main`` (or ``main_1``… of a crank body
+        on several journals), ``big_end_<i>``, ``small_end_<i>`` (i from 1). Deprecated, still
+        accepted with one DeprecationWarning (:func:`clearance_specs`): ``{joint_name:
+        {"clearance": m, "journal_radius": m, "contact": {overrides}, ...}}`` with
+        ``contact_kw``.
     contact_kw : dict, optional
-        ``law, law_params, friction, friction_params, v_impact_min`` of the clearance joints.
+        Deprecated: ``law, law_params, friction, friction_params, v_impact_min`` of the dict
+        form of ``clearances``.
     gravity : (2,)
         m/s^2.
     baumgarte : float, optional

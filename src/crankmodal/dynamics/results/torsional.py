@@ -48,7 +48,7 @@ def torsion_histories(mech, sysm, integ) -> dict:
         tw, tq = np.zeros(K), np.zeros(K)
         for k in range(K):
             q, qd = integ.y[:n, k], integ.y[n:2 * n, k]
-            tq[k], _, _, wa, wb = cp.coupling_torque(sysm, q, qd)
+            tq[k] = cp.coupling_torque(sysm, q, qd)[0]
             tw[k] = (sysm.frame_pose_only(cp.a, cp.frame_a, q)[2]
                      - sysm.frame_pose_only(cp.b, cp.frame_b, q)[2])
         out["coupling_twist"] = tw
@@ -132,8 +132,8 @@ def _order_amplitudes(t, x, revolution_hz, orders) -> np.ndarray:
     lowest half order, as orders of a slower fundamental."""
     orders = np.asarray(orders, float)
     if np.allclose(orders, np.round(orders)):
-        return order_amplitudes(t, x, revolution_hz, [int(round(o)) for o in orders])
-    return order_amplitudes(t, x, revolution_hz / 2.0, [int(round(2 * o)) for o in orders])
+        return order_amplitudes(t, x, revolution_hz, [round(o) for o in orders])
+    return order_amplitudes(t, x, revolution_hz / 2.0, [round(2 * o) for o in orders])
 
 
 def torsional_sweep(make_mechanism, speeds_rpm, revolutions: float, settle_revolutions: float,
