@@ -195,6 +195,7 @@ def _check_window(p: dict, pd: dict, mp) -> None:
     speed = pd["speed_rpm"] or (mp or {}).get("speed_rpm")
     if not speed:
         return  # a torque drive without a speed: checked on the run's crank angle
+    key = "dynamics.speed_rpm" if pd["speed_rpm"] else "mechanism.speed_rpm"
     rev_s = 60.0 / float(speed)
     need = settled_from(pd, rev_s) + p["cycles"] * p["cycle_deg"] / 360.0 * rev_s
     if pd["end_time"] < need * (1.0 - 1e-9):
@@ -203,8 +204,8 @@ def _check_window(p: dict, pd: dict, mp) -> None:
                  f"the ramp ({pd['ramp_time']:g} s) and one settling revolution")
         raise SceneError(f"dynamics.end_time: {pd['end_time']:g} s holds no {p['cycles']} steady "
                          f"cycle(s) of {p['cycle_deg']:g} deg for [fatigue] after {after} at "
-                         f"{float(speed):g} rpm: give end_time >= {need:.4g} s (or fewer "
-                         f"fatigue.cycles)")
+                         f"{float(speed):g} rpm ({key}): give end_time >= {need:.4g} s (or "
+                         f"fewer fatigue.cycles)")
 
 
 def settled_from(pd: dict, revolution_s: float) -> float:
