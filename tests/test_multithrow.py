@@ -465,3 +465,24 @@ def test_seed004_flexible_crank_on_three_journals_held_under_constant_pin_loads_
     np.testing.assert_allclose(got, -mu, rtol=0, atol=0.01 * sum(loads))
     np.testing.assert_allclose(got[:, 1], -mu[:, 1], rtol=0.01)
     assert -got[1, 1] > 0.5 * sum(loads)
+
+
+def test_four_star_with_its_machines_arrangement_builds_the_same_system_as_one_pin():
+    """Seed 000's four-star keeps working unchanged: its four cylinders on one throw at 0 deg
+    (the machine's arrangement, one throw each, all at the same phase) give the same crank
+    frames, start and compiled tables as the one-pin train of before."""
+    from crankmodal.dynamics.model.bridge import cylinders_from_mechanism
+    from crankmodal.mechanism.stage import validate as validate_mechanism
+    from crankmodal.resources import load_machine
+
+    src = cylinders_from_mechanism(validate_mechanism(load_machine("four_star_compressor")
+                                                      ["mechanism"]))
+    kw = {"direction": -1, "crank_mass": 10.0, "crank_com": 0.01, "crank_inertia": 0.2}
+    a = crank_train(src["crank_radius"], src["cylinders"], 1480.0,
+                    arrangement=src["arrangement"], **kw)
+    b = crank_train(src["crank_radius"], src["cylinders"], 1480.0, **kw)
+    assert a.crank.frames == b.crank.frames == {"main": (-0.01, 0.0), "pin": (a.crank.frames[
+        "pin"][0], 0.0)}
+    ka, kb = a.system.kernel(), b.system.kernel()
+    assert np.array_equal(ka.I, kb.I) and np.array_equal(ka.F, kb.F)
+    assert np.array_equal(a.q0, b.q0) and np.array_equal(a.qd0, b.qd0)
