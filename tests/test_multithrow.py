@@ -486,3 +486,23 @@ def test_four_star_with_its_machines_arrangement_builds_the_same_system_as_one_p
     ka, kb = a.system.kernel(), b.system.kernel()
     assert np.array_equal(ka.I, kb.I) and np.array_equal(ka.F, kb.F)
     assert np.array_equal(a.q0, b.q0) and np.array_equal(a.qd0, b.qd0)
+
+
+def test_crank_body_pins_off_their_throws_phases_are_refused_naming_the_pin():
+    from crankmodal.dynamics.model.bodies import RigidBody
+
+    two = Arrangement(throw_angles=(0.0, np.pi), cylinder_throws=(0, 1), bank_angles=(0.0, 0.0))
+    cyl = Cylinder(axis_angle=np.pi / 2, rod_length=L, rod_mass=MR, rod_inertia=IR, rod_com=A,
+                   piston_mass=MP)
+    roles = {"mains": ["main"], "pins": ["pin_1", "pin_2"], "drive": "main"}
+    wrong = RigidBody("crank", 10.0, 0.2, {"main": (0.0, 0.0), "pin_1": (R, 0.0),
+                                           "pin_2": (0.0, R)})   # 90 deg, not 180
+    with pytest.raises(ParameterError) as exc:
+        crank_train(R, [cyl, cyl], 600.0, direction=-1, arrangement=two, crank_body=wrong,
+                    crank_roles=roles)
+    assert exc.value.argument == "crank_roles.pins[1]"
+    right = RigidBody("crank", 10.0, 0.2, {"main": (0.0, 0.0), "pin_1": (R, 0.0),
+                                           "pin_2": (-R, 0.0)})
+    mech = crank_train(R, [cyl, cyl], 600.0, direction=-1, arrangement=two, crank_body=right,
+                       crank_roles=roles)
+    assert mech.reference_angle == 0.0
