@@ -233,3 +233,42 @@ def test_an_impacting_run_reports_the_spread_over_its_trajectories(tmp_path):
     one = cm.run_scene(scene(1), tmp_path / "one", figures=False)["fatigue"]
     assert "ensemble" not in one
     assert any("clearance joints and one trajectory" in w for w in one["warnings"])
+
+
+def test_an_unstressed_location_is_written_as_null_not_infinity():
+    from crankmodal.fatigue.stage import json_safe
+    from crankmodal.results import to_jsonable
+
+    out = json_safe({"locations": {"a": {"safety_factor": np.inf, "n": 3}},
+                     "spread": [1.5, np.float64(np.inf)], "text": "x"})
+    assert out == {"locations": {"a": {"safety_factor": None, "n": 3}},
+                   "spread": [1.5, None], "text": "x"}
+    to_jsonable(out)  # refuses non-finite values: passes now
+
+
+def test_report_section_lists_every_location_lowest_first():
+    from crankmodal.fatigue.report import fatigue_blocks
+    from crankmodal.report.modal_report import Report
+
+    res = {"criterion": {"rule": "goodman", "mean_stress": "sines",
+                         "equivalent_alternating": "von Mises of the amplitude tensor"},
+           "factors": {"surface": 0.74, "size": 0.83, "reliability": 0.814, "other": 1.0,
+                       "notch": 1.0},
+           "fatigue_strength_pa": 2.3e8, "specimen_fatigue_strength_pa": 4.65e8,
+           "ultimate_strength_pa": 9.3e8, "material": "42CrMo", "required_safety_factor": 1.5,
+           "passed": True,
+           "ensemble": {"n_trajectories": 2, "min_safety_factor": [5.2, 5.4],
+                        "worst_location": ["crankpin_1_fillet_web_2", None],
+                        "spread": {"min": 5.2, "mean": 5.3, "max": 5.4}},
+           "locations": {name: {"kind": "k", "safety_factor": n, "alternating_pa": 1e7,
+                                "mean_pa": 2e7, "max_von_mises_pa": 3e7,
+                                "proportionality": 1.0, "n_points": 10}
+                         for name, n in (("elsewhere", 9.0), ("crankpin_1_fillet_web_2", 5.2),
+                                         ("main_journal_1_fillet_web_1", None))}}
+    rep = Report("t")
+    fatigue_blocks(rep, res)
+    html = rep.to_html()
+    i, j, k = (html.find(s) for s in ("crankpin 1 fillet web 2", "elsewhere",
+                                      "main journal 1 fillet web 1"))
+    assert -1 < i < j < k  # lowest first, the unstressed (∞) last
+    assert "230 MPa" in html and "5.2" in html and "∞" in html

@@ -8,6 +8,11 @@ stage's ``figures``. Nothing heavy is imported.
 from __future__ import annotations
 
 
+def _n(v) -> str:
+    """A safety factor; None (results.json's infinite: no stress) as ∞."""
+    return "∞" if v is None else f"{v:.3g}"
+
+
 def fatigue_blocks(report, res: dict) -> None:
     """The criterion and strength, the ensemble's spread, and the per-location table (worst
     point of each location, lowest first)."""
@@ -30,16 +35,18 @@ def fatigue_blocks(report, res: dict) -> None:
         s = ens["spread"]
         report.paragraph(
             f"Ensemble of {ens['n_trajectories']} trajectories (an impacting run: each "
-            f"trajectory's last cycle assessed): lowest safety factor min {s['min']:.3g}, mean "
-            f"{s['mean']:.3g}, max {s['max']:.3g}.")
+            f"trajectory's last cycle assessed): lowest safety factor min {_n(s['min'])}, mean "
+            f"{_n(s['mean'])}, max {_n(s['max'])}.")
         report.table(["trajectory", "lowest safety factor", "worst location"],
-                     [[k + 1, f"{n:.3g}", (w or "-").replace("_", " ")]
+                     [[k + 1, _n(n), (w or "-").replace("_", " ")]
                       for k, (n, w) in enumerate(zip(ens["min_safety_factor"],
                                                      ens["worst_location"]))])
     locs = res.get("locations") or {}
     rows = []
-    for name, d in sorted(locs.items(), key=lambda kv: kv[1]["safety_factor"]):
-        rows.append([name.replace("_", " "), d.get("kind"), f"{d['safety_factor']:.3g}",
+    inf = float("inf")
+    for name, d in sorted(locs.items(), key=lambda kv: (kv[1]["safety_factor"] is None,
+                                                         kv[1]["safety_factor"] or inf)):
+        rows.append([name.replace("_", " "), d.get("kind"), _n(d["safety_factor"]),
                      fmt(d.get("alternating_pa"), "Pa"), fmt(d.get("mean_pa"), "Pa"),
                      fmt(d.get("max_von_mises_pa"), "Pa"),
                      f"{d['proportionality']:.3g}" if d.get("proportionality") is not None

@@ -426,7 +426,19 @@ def run(p: dict, ctx) -> dict:
     out["summary"] = summary_line(out)
     res.save(ctx.out_dir / "fatigue.npz")
     ctx.products[SECTION] = res
-    return out
+    return json_safe(out)
+
+
+def json_safe(obj):
+    """``obj`` with every infinite number (a safety factor where the stress does not vary and
+    has no mean) as None: results.json refuses non-finite values; ``null`` reads "infinite"."""
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, (float, np.floating)) and math.isinf(obj):
+        return None
+    return obj
 
 
 def _figures(res, fb, out_dir, body: str) -> list[str]:
