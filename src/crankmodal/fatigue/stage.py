@@ -366,7 +366,8 @@ def _ensemble(p, body, fb, members, t_min, span, S, nodes, locations, base) -> d
     return {"n_trajectories": len(rows), "min_safety_factor": n.tolist(),
             "worst_location": [r[1] for r in rows],
             "spread": {"min": float(n.min()), "mean": float(n.mean()), "max": float(n.max()),
-                       "std": float(n.std(ddof=1)) if len(n) > 1 else 0.0}}
+                       "std": (float(n.std(ddof=1)) if len(n) > 1 else 0.0)
+                       if np.all(np.isfinite(n)) else None}}
 
 
 def run(p: dict, ctx) -> dict:
