@@ -506,3 +506,21 @@ def test_crank_body_pins_off_their_throws_phases_are_refused_naming_the_pin():
     mech = crank_train(R, [cyl, cyl], 600.0, direction=-1, arrangement=two, crank_body=right,
                        crank_roles=roles)
     assert mech.reference_angle == 0.0
+
+
+@pytest.mark.parametrize("table, key", [
+    ({"journals_z": [-0.1, 0.1]}, "dynamics.crank_train.journals_z"),   # with a flexible crank
+    ({"motor_inertia": 0.1}, "dynamics.crank_train.coupling_stiffness"),
+    ({"coupling_stiffness": 1e4}, "dynamics.crank_train.motor_inertia"),
+    ({"coupling_damping": 2.0}, "dynamics.crank_train.coupling_damping"),
+])
+def test_train_key_cross_checks_name_the_key(table, key):
+    from crankmodal.dynamics.scene.keys import validate_section
+    from crankmodal.errors import SceneError
+
+    raw = {"from_mechanism": True, "crank_train": table}
+    if "journals_z" in table:
+        raw["flexible"] = {"crank": {"n_modes": 4}}
+    with pytest.raises(SceneError) as exc:
+        validate_section(raw)
+    assert str(exc.value).startswith(key + ":")

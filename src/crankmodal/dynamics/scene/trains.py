@@ -53,6 +53,9 @@ def check_train_keys(p) -> None:
     if ct.get("coupling_damping") and ct.get("motor_inertia") is None:
         raise SceneError(f"{KEY}.coupling_damping: needs motor_inertia and coupling_stiffness")
     jz = ct.get("journals_z")
+    if jz is not None and (p.get("flexible") or {}).get("crank") is not None:
+        raise SceneError(f"{KEY}.journals_z: is for a rigid crank; a flexible crank's main "
+                         "journals are its own (main_1..N)")
     if jz is not None and len(jz) > 2:
         raise SceneError(f"{KEY}.journals_z: a rigid crank on {len(jz)} main journals is "
                          "statically indeterminate (only the crank's flexibility shares the "
