@@ -129,23 +129,25 @@ from crankmodal.dynamics.run.integrate import integrate
 cyl = Cylinder(axis_angle=0.0, rod_length=0.14, rod_mass=0.9, rod_inertia=3.1e-3, rod_com=0.042,
                piston_mass=0.75)
 m = crank_train(0.035, [cyl], 3000.0, crank_mass=2.0, crank_inertia=0.01)
-t1 = time.perf_counter()
+t1, c1 = time.perf_counter(), time.process_time()
 integrate(m.system, m.q0, m.qd0, 1e-3, None, SolverSettings(method="RK45"))
-print(time.perf_counter() - t1)
+print(time.perf_counter() - t1, time.process_time() - c1)
 """
 
 
 def compile_times():
-    """First use (fresh cache directory) and cached load, s: a slider-crank's first integrate()
-    (the kernel and the loop compiled or loaded) in a new process."""
+    """First use (fresh cache directory) and cached load, s (wall, CPU): a slider-crank's first
+    integrate() (the kernel and the loop compiled or loaded) in a new process."""
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
         env = dict(os.environ, NUMBA_CACHE_DIR=tmp)
         for key in ("first_use_s", "cached_s"):
             r = subprocess.run([sys.executable, "-c", _COMPILE], env=env, capture_output=True,
                                text=True, check=True, cwd=ROOT)
-            out[key] = float(r.stdout.split()[-1])
-            print(f"loop + kernel {key}: {out[key]:.2f} s", flush=True)
+            wall, cpu = (float(x) for x in r.stdout.split()[-2:])
+            out[key] = wall
+            out[key.replace("_s", "_cpu_s")] = cpu
+            print(f"loop + kernel {key}: {wall:.2f} s wall, {cpu:.2f} s CPU", flush=True)
     return out
 
 

@@ -31,7 +31,17 @@ from numba import njit
 from scipy.integrate import RK45
 from scipy.integrate._ivp.rk import MAX_FACTOR, MIN_FACTOR, SAFETY
 
-from .compiled import DIAG, N_AUX, clearance_kinematics, drive_values, evaluate, flush_if_changed
+from .compiled import (
+    DIAG,
+    N_AUX,
+    _dgesv,
+    assemble,
+    clearance_kinematics,
+    drive_values,
+    evaluate,
+    finish,
+    flush_if_changed,
+)
 
 #: the Dormand-Prince 5(4) pair of SciPy's RK45: C, A, B, E (7 stages with FSAL), P (dense)
 _TABLEAU = (np.asarray(RK45.C, float), np.ascontiguousarray(RK45.A, float),
@@ -87,10 +97,113 @@ def _rms(x):
 
 
 @njit(cache=True)
+def _cholesky_solve(sz, L, b, x):
+    """``x = B^-1 b`` for a symmetric positive definite ``B = L L^T`` (``L`` lower, ``sz``)."""
+    for i in range(sz):
+        v = b[i]
+        for k in range(i):
+            v -= L[i, k] * x[k]
+        x[i] = v / L[i, i]
+    for i in range(sz - 1, -1, -1):
+        v = x[i]
+        for k in range(i + 1, sz):
+            v -= L[k, i] * x[k]
+        x[i] = v / L[i, i]
+
+
+@njit(cache=True)
+def block_solve(A, rhs, n, B):
+    """Solve :func:`.compiled.assemble`'s whole KKT system ``A x = rhs`` (``[M Cq^T; Cq 0]``,
+    flexible bodies without an oil film) by its block-diagonal mass matrix, in place in ``rhs``
+    (``[qdd; lam]``, what :func:`.compiled.finish` reads).
+
+    The mass matrix is diagonal but for each flexible body's (theta, xi) block (``M(xi)``, SPD:
+    Cholesky) and zero for massless coordinates (a piston's rotation); with ``a`` the massive
+    coordinates and ``b`` the massless ones, ``Y = M_a^-1 [Q_a, Cq_a^T]`` by blocks and the
+    system left is the rigid path's reduced one,
+    ``[0, Cq_b^T; Cq_b, -Cq_a Y_C] [qdd_b; lam] = [Q_b; gamma - Cq_a Y_Q]`` (LAPACK dgesv),
+    then ``qdd_a = Y_Q - Y_C lam``, each sum over the constraint rows that touch a coordinate's
+    block (``yr_rows[yr_ptr[i]:yr_ptr[i + 1]]``; Y is zero elsewhere and never read). For the
+    flexible four-star (80 unknowns, 27 left) this costs a third of the LU of the whole system.
+    Returns 0, 2 (singular) or 3 (a block not positive definite: the caller solves the whole
+    system instead).
+    """
+    blk, singles, a_idx, massless, Y, S, r, ipiv, ints, L, col, x, yr_ptr, yr_rows = B
+    m = rhs.size - n
+    for i in singles:
+        d = A[i, i]
+        Y[i, 0] = rhs[i] / d
+        for k in range(yr_ptr[i], yr_ptr[i + 1]):
+            c = yr_rows[k]
+            Y[i, 1 + c] = A[n + c, i] / d
+    for bi in range(blk.shape[0]):
+        s0, sz = blk[bi, 0], blk[bi, 1]
+        for i in range(sz):
+            for j in range(i + 1):
+                v = A[s0 + i, s0 + j]
+                for k in range(j):
+                    v -= L[i, k] * L[j, k]
+                if i == j:
+                    if v <= 0.0:
+                        return 3
+                    L[i, i] = np.sqrt(v)
+                else:
+                    L[i, j] = v / L[j, j]
+        for k in range(yr_ptr[s0] - 1, yr_ptr[s0 + 1]):  # Q, then the rows touching it
+            c = 0 if k < yr_ptr[s0] else 1 + yr_rows[k]
+            for i in range(sz):
+                col[i] = rhs[s0 + i] if c == 0 else A[n + c - 1, s0 + i]
+            _cholesky_solve(sz, L, col, x)
+            for i in range(sz):
+                Y[s0 + i, c] = x[i]
+    nb = massless.size
+    # the reduced system stored transposed: LAPACK reads a C-ordered array as its transpose
+    S[:, :] = 0.0
+    for bk in range(nb):
+        i = massless[bk]
+        r[bk] = rhs[i]
+        for c in range(m):
+            S[bk, nb + c] = A[n + c, i]
+            S[nb + c, bk] = A[n + c, i]
+    for c in range(m):
+        r[nb + c] = rhs[n + c]
+    for i in a_idx:
+        for k1 in range(yr_ptr[i], yr_ptr[i + 1]):
+            c1 = yr_rows[k1]
+            cq = A[n + c1, i]
+            if cq != 0.0:
+                r[nb + c1] -= cq * Y[i, 0]
+                for k2 in range(yr_ptr[i], yr_ptr[i + 1]):
+                    c2 = yr_rows[k2]
+                    S[nb + c2, nb + c1] -= cq * Y[i, 1 + c2]
+    if r.size:
+        ints[0], ints[1], ints[2] = r.size, 1, 0
+        _dgesv(ints[0:].ctypes, ints[1:].ctypes, S.ctypes, ints[0:].ctypes, ipiv.ctypes,
+               r.ctypes, ints[0:].ctypes, ints[2:].ctypes)
+        if ints[2] != 0:
+            return 2
+    for c in range(m):
+        rhs[n + c] = r[nb + c]
+    for bk in range(nb):
+        rhs[massless[bk]] = r[bk]
+    for i in a_idx:
+        v = Y[i, 0]
+        for k in range(yr_ptr[i], yr_ptr[i + 1]):
+            c = yr_rows[k]
+            v -= Y[i, 1 + c] * r[nb + c]
+        rhs[i] = v
+    return 0
+
+
+@njit(cache=True)
 def _fun(t, y, dy, M, fs, ns):
     """One counted right-hand side into ``dy``: _OK, or BUDGET / NONFINITE / SINGULAR with the
-    time in ``fs[_TFAIL]`` (the budget judged before the evaluation, as Multibody.rhs)."""
-    tabs, work, drv, dv, vimp, gas_py, phi, Cq, diag, powers, lam = M
+    time in ``fs[_TFAIL]`` (the budget judged before the evaluation, as Multibody.rhs).
+
+    :func:`.compiled.evaluate`, or with flexible bodies (``B`` not empty) its
+    :func:`assemble` and :func:`finish` around :func:`block_solve` instead of the LU of the
+    whole system."""
+    tabs, work, drv, dv, vimp, gas_py, phi, Cq, diag, powers, lam, B = M
     ns[_NFEV] += 1
     if ns[_NFEV] > ns[_MAXNFEV]:
         fs[_TFAIL] = t
@@ -99,8 +212,18 @@ def _fun(t, y, dy, M, fs, ns):
     drive_values(t, drv, dv)
     for i in range(n):
         dy[i] = y[n + i]
-    status = evaluate(t, y[:n], y[n:2 * n], dv, vimp, gas_py, tabs, work, phi, Cq, diag,
-                      powers, dy[n:2 * n], lam)
+    status = 3
+    if B[0].shape[0]:
+        I, io, F, fo = tabs
+        Q, cqd, A, rhs = work[0], work[1], work[2], work[3]
+        assemble(t, y[:n], y[n:2 * n], dv, vimp, gas_py, I, io, F, fo, phi, Cq, diag, powers,
+                 Q, cqd, A, rhs)
+        status = block_solve(A, rhs, n, B)
+        if status == 0:
+            status = 0 if finish(rhs, Q, Cq, cqd, I, io, F, fo, dy[n:2 * n], lam, powers) else 1
+    if status == 3:
+        status = evaluate(t, y[:n], y[n:2 * n], dv, vimp, gas_py, tabs, work, phi, Cq, diag,
+                          powers, dy[n:2 * n], lam)
     for i in range(N_AUX):
         dy[2 * n + i] = powers[i]
     if status == 0:
@@ -404,6 +527,76 @@ def advance(fs, ns, V, K, Qd, atol, M, tab, ctl, ev, out, io_bufs):
 
 
 # ------------------------------------------------------------------------------ Python driver
+def blocks(sysm, k, use=True):
+    """The tables of :func:`block_solve` for a system whose kernel solves the whole KKT system
+    because of flexible bodies (not with an oil film: that keeps the KKT's exact drive row,
+    see :class:`.CompiledSystem`); empty tables otherwise or with ``use`` False."""
+    I, io, F, fo = k.tabs
+    n, m = k.n, k.m
+    full = bool(I[io[20]])
+    fb = I[io[19]:io[20]].reshape(-1, 3)
+    film = any(cj.viscosity is not None for cj in sysm.clearances)
+    if not use or not full or film or not fb.size:
+        e = np.zeros(0, np.int64)
+        return (np.zeros((0, 2), np.int64), e, e, e, np.zeros((0, 0)), np.zeros((0, 0)),
+                np.zeros(0), np.zeros(0, np.int32), np.zeros(3, np.int32), np.zeros((0, 0)),
+                np.zeros(0), np.zeros(0), np.zeros(1, np.int64), e)
+    mdiag = F[fo[2]:fo[3]]
+    blk = np.array([(c0 + 2, 1 + kk) for c0, kk, _ in fb], np.int64).reshape(-1, 2)
+    in_block = np.zeros(n, bool)
+    for s0, sz in blk:
+        in_block[s0:s0 + sz] = True
+    singles = np.flatnonzero((mdiag > 0.0) & ~in_block).astype(np.int64)
+    massless = np.flatnonzero((mdiag == 0.0) & ~in_block).astype(np.int64)
+    a_idx = np.flatnonzero((mdiag > 0.0) | in_block).astype(np.int64)
+    nr = massless.size + m
+    big = int(blk[:, 1].max())
+    # per coordinate the constraint rows touching it (its column of Cq's pattern), or its
+    # block's (the union over the block: M_block^-1 mixes them)
+    col_ptr, col_rows = I[io[16]:io[17]], I[io[17]:io[18]]
+    rows = [set(col_rows[col_ptr[i]:col_ptr[i + 1]].tolist()) for i in range(n)]
+    for s0, sz in blk:
+        union = set().union(*rows[s0:s0 + sz])
+        for i in range(s0, s0 + sz):
+            rows[i] = union
+    yr_rows = [sorted(r) for r in rows]
+    yr_ptr = np.concatenate([[0], np.cumsum([len(r) for r in yr_rows])]).astype(np.int64)
+    yr_flat = np.array([c for r in yr_rows for c in r], np.int64)
+    return (blk, singles, a_idx, massless, np.zeros((n, m + 1)), np.zeros((nr, nr)),
+            np.zeros(nr), np.zeros(nr, np.int32), np.zeros(3, np.int32), np.zeros((big, big)),
+            np.zeros(big), np.zeros(big), yr_ptr, yr_flat)
+
+
+def model(sysm, use_blocks: bool = True) -> tuple:
+    """What the compiled right-hand side of the loop reads: the kernel's tables and work
+    arrays (:class:`.CompiledSystem`, shared: its impact velocities ``vimp`` are the loop's),
+    scratch arrays and the tables of :func:`block_solve` (empty without ``use_blocks``)."""
+    k = sysm.kernel()
+    nc = len(sysm.clearances)
+    return (k.tabs, k._work, k.drv, np.zeros((len(k.drives), 3)), k.vimp, k.gas_py,
+            np.empty(k.m), np.empty((k.m, k.n)), np.zeros((nc, _NDIAG)), np.zeros(N_AUX),
+            np.empty(k.m), blocks(sysm, k, use_blocks))
+
+
+def rhs(sysm, t, y, use_blocks: bool = True) -> np.ndarray:
+    """The loop's right-hand side at ``(t, y)`` called from Python (tests): ``dy``.
+
+    Raises
+    ------
+    NumericalError
+        When the evaluation fails (non-finite, singular).
+    """
+    from ...errors import NumericalError
+
+    dy = np.zeros(len(y))
+    fs, ns = np.zeros(8), np.zeros(6, np.int64)
+    ns[_MAXNFEV] = 1
+    code = _fun(float(t), np.ascontiguousarray(y, float), dy, model(sysm, use_blocks), fs, ns)
+    if code != _OK:
+        raise NumericalError(f"right-hand side failed at t = {t} s (code {code})")
+    return dy
+
+
 def applicable(sysm, method: str) -> bool:
     """True when :func:`run` integrates ``sysm`` with ``method``: RK45 on a system whose whole
     right-hand side is compiled (:attr:`.CompiledSystem.loop_ready`)."""
@@ -457,9 +650,7 @@ def run(sysm, y0, t_end, t_out, settings, atol, pbar=None, guard=None):
     memory = any(cj.needs_memory for cj in sysm.clearances)
     v_impact = np.array([cj.v_impact_min for cj in sysm.clearances], float)
     k.vimp[:] = v_impact
-    nm = len(k.drives)
-    M = (k.tabs, k._work, k.drv, np.zeros((nm, 3)), k.vimp, k.gas_py, np.empty(k.m),
-         np.empty((k.m, n)), np.zeros((nc, _NDIAG)), np.zeros(N_AUX), np.empty(k.m))
+    M = model(sysm)
     y = np.array(y0, float)
     V = tuple(np.zeros(ny) for _ in range(6))
     V[0][:] = y
