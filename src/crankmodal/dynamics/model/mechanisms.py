@@ -35,7 +35,10 @@ class Cylinder:
 
     ``rod_com`` is the distance of the rod's centre of mass from the big-end centre; ``offset``
     the piston-pin offset across the cylinder axis (positive towards +90 deg from the axis);
-    ``z`` the axial row position along the crankpin (for 3D moments).
+    ``z`` the axial position of the cylinder's plane (its rod row) along the crank axis, m (for
+    3D moments and, with ``journals_z``, the split between a rigid crank's two journals). Its
+    throw is not a field: a multi-throw train's throws are its ``arrangement``'s
+    (:func:`crank_train`).
 
     Attributes
     ----------
