@@ -140,3 +140,80 @@ def test_radau_with_the_compiled_jacobian_follows_the_same_trajectory(monkeypatc
         peak = np.max(np.abs(ref[blk]))
         for a, b in ((with_jac, ref), (without, ref), (with_jac, without)):
             assert np.max(np.abs(a[blk] - b[blk])) <= bound * peak
+
+
+def test_lsoda_on_a_film_with_the_compiled_jacobian_follows_the_same_trajectory(monkeypatch):
+    """Seed 001's short-bearing film carrying the big end of a rigid two-cylinder train (no
+    dry contact: smooth), LSODA at rtol 1e-6 with the compiled Jacobian and with SciPy's own
+    finite differences, against LSODA at rtol 1e-10 (the converged trajectory). LSODA's Jacobian
+    steers its Newton iterations and its switch to BDF, not the solution: both runs carry
+    LSODA's error at rtol 1e-6: measured 1.5e-7 (positions) and 5.1e-7 (velocities) of the
+    peaks against the reference, 8e-10 and 2e-9 between the two; 5e-6 (5 rtol) for all."""
+    from test_kernel_implicit import _train
+
+    from crankmodal.dynamics.kernel import jacobian as jm
+
+    mech = _train(flexible=False, film=True)
+    sysm, n = mech.system, mech.system.n
+    t_out = np.linspace(0.0, 0.01, 41)
+
+    def run(rtol, compiled):
+        if not compiled:
+            monkeypatch.setattr(jm, "jacobian_for", lambda *a, **k: {})
+        try:
+            out = integrate(sysm, mech.q0, mech.qd0, 0.01, t_out,
+                            SolverSettings(method="LSODA", rtol=rtol, atol=rtol * 1e-4))
+        finally:
+            monkeypatch.undo()
+        assert not out.onsets[0]  # floating on the film
+        return out
+
+    ref = run(1e-10, True).y
+    with_jac, without = run(1e-6, True), run(1e-6, False)
+    assert with_jac.nfev < without.nfev
+    for blk in (slice(0, n), slice(n, 2 * n)):
+        peak = np.max(np.abs(ref[blk]))
+        errs = [np.max(np.abs(a[blk] - b[blk])) / peak
+                for a, b in ((with_jac.y, ref), (without.y, ref), (with_jac.y, without.y))]
+        assert max(errs) <= 5e-6
+
+
+@pytest.mark.slow
+def test_loom_film_statistics_within_the_ensemble_spread_of_the_former_jacobian(monkeypatch):
+    """Seed 001's loom, 1 s (7.5 revolutions at 450 rpm), its lubricated coupler pin with dry
+    Lankarani-Nikravesh impacts (LSODA, restarted at every contact event): an impacting run,
+    so its numbers are statistics. The run with the compiled Jacobian and two round-off
+    perturbed ones (an ensemble of three, as [dynamics] ensemble = 3 runs it) against the run
+    with SciPy's own finite-difference Jacobian (the former path): each headline per-revolution
+    statistic of the former within three times the ensemble's spread (its standard deviation,
+    or the revolutions' standard error where larger) of the ensemble's mean."""
+    from pathlib import Path
+
+    from crankmodal.dynamics.kernel import jacobian as jm
+    from crankmodal.dynamics.results.stats import statistics
+    from crankmodal.dynamics.run.ensemble import headline, run_ensemble
+    from crankmodal.dynamics.run.simulate import simulate
+    from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
+    from crankmodal.runner import check
+    from crankmodal.scene import load_scene
+
+    scene = Path(__file__).resolve().parent.parent / "scenes" / "loom_four_bar_dynamics.toml"
+    p = check(load_scene(scene, ["dynamics.end_time=1.0"]))["dynamics"]
+    settings = solver_settings(p, 450.0)
+    assert settings.method == "LSODA"
+    mech = build_mechanism(p)
+    rev_hz = mech.revolution_hz
+    dt, t_start = 1.0 / (360.0 * rev_hz), 1.0 / rev_hz  # the first revolution: start-up
+
+    def stats(m):
+        return statistics(simulate(m, 1.0, dt, settings), rev_hz, t_start)
+
+    base = stats(mech)
+    ens = run_ensemble(mech, base, 3, 1.0, dt, settings, rev_hz, t_start, {})
+    monkeypatch.setattr(jm, "jacobian_for", lambda *a, **k: {})
+    former = headline(stats(build_mechanism(p)))
+    monkeypatch.undo()
+    assert ens["spread"]
+    for key, s in ens["spread"].items():
+        sem = np.sqrt(np.mean([r[key] ** 2 for r in ens["per_trajectory_sem"] if key in r]))
+        assert abs(former[key] - s["mean"]) <= 3.0 * max(s["std"], sem), key
