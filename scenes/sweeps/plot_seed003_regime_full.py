@@ -105,13 +105,14 @@ def main() -> None:
         for t in grid:
             if round(t["pz"], 3) == pz:
                 i, j = speeds.index(t["rpm"]), wears.index(round(t["wear"], 4))
-                ax.text(j + 0.5, i + 0.5, f"{t['cyc']:.2f}\n±{t['cyc_sem']:.2f}", ha="center",
+                ax.text(j + 0.5, i + 0.5, f"{t['cyc']:.3f}\n±{t['cyc_sem']:.3f}", ha="center",
                         va="center", fontsize=7,
                         color="w" if t["cyc"] < 0.5 * vmax else "k")
         ax.set_xticks(np.arange(len(wears)) + 0.5, [f"{w:.3f}" for w in wears])
         ax.set_yticks(np.arange(len(speeds)) + 0.5, [f"{s:.0f}" for s in speeds])
         ax.set_xlabel("worn big end: major radial clearance, mm")
-        ax.set_ylabel("speed, rpm")
+        if ax is axes[0][0]:
+            ax.set_ylabel("speed, rpm")
         ax.set_title(f"peak cylinder pressure {pz:g} MPa", fontsize=9)
     fig.colorbar(pc, ax=axes[0].tolist(),
                  label="largest big-end impact velocity per cycle (mean), m/s")

@@ -299,11 +299,11 @@ def plot(out: Path) -> None:
                                  squeeze=False)
         x = np.arange(len(names))
         for row, g in zip(axes, groups):
-            c = g[-1].upper()
+            c = g[-1]
             for ax, (k, label) in zip(row, keys):
                 e = [d[n]["ensemble"][g][k] for n in names]
                 ax.bar(x, [v["mean"] / 1e3 for v in e], yerr=[2 * v["sem"] / 1e3 for v in e],
-                       capsize=4, color="C0" if c == "X" else "C2")
+                       capsize=4, color="C0" if c == "x" else "C2")
                 ax.plot(x, [v["min"] / 1e3 for v in e], "k_", ms=12)
                 ax.plot(x, [v["max"] / 1e3 for v in e], "k_", ms=12)
                 ideal = d[names[0]]["ideal"][g][k]["mean"] / 1e3
@@ -317,7 +317,7 @@ def plot(out: Path) -> None:
         n = d[names[0]]["ensemble"]["n_trajectories"]
         fig.suptitle(f"Seed 000 Fig. 27: main-bearing force with 0.1 mm clearance added "
                      f"cumulatively (mean of {n} trajectories ± 2 SE; ticks: smallest and "
-                     f"largest trajectory; X along cylinders 3/4, Y along cylinders 1/2)",
+                     f"largest trajectory; x along cylinders 3/4, y along cylinders 1/2)",
                      fontsize=9)
         fig.tight_layout()
         fig.savefig(IMG / "seed000_fig27_cumulative.png", dpi=110)
