@@ -156,6 +156,7 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--skip-flexible", action="store_true")
     ap.add_argument("--skip-compile", action="store_true")
+    ap.add_argument("--only-flexible", action="store_true")
     a = ap.parse_args(argv)
     out = {"load_average": os.getloadavg()}
     if not a.skip_compile:
@@ -169,6 +170,8 @@ def main(argv=None):
                      'journal_radius = 0.0225}]')
         cases.append(("flexible four-star + 0.1 mm, 1 s", partial(_flexible_mechanism, [
             "dynamics.end_time=1.0", "dynamics.run_rigid=false", clearance]), 1.0))
+    if a.only_flexible:
+        cases = cases[2:]
     out["cases"] = {}
     for label, build, t_end in cases:
         rows, med = compare(label, build, t_end, a.repeats)
@@ -182,7 +185,8 @@ def main(argv=None):
               f"{lp['integration_wall_s']:.2f} / {lp['integration_cpu_s']:.2f} | "
               f"{s['rhs_evals']:.0f} / {lp['rhs_evals']:.0f} | "
               f"{s['integration_cpu_s'] / lp['integration_cpu_s']:.1f}x |")
-    path = ROOT / "benchmarks" / "out" / "kernel_loop.json"
+    path = ROOT / "benchmarks" / "out" / ("kernel_loop_flexible.json" if a.only_flexible
+                                          else "kernel_loop.json")
     path.parent.mkdir(exist_ok=True)
     path.write_text(json.dumps(out, indent=2))
     print(f"written: {path}")

@@ -280,3 +280,14 @@ def test_flexible_train_loop_equals_solve_ivp_to_round_off():
         peak = np.abs(ref.y[rows]).max(axis=1)
         err = np.abs(loop.y[rows] - ref.y[rows]).max(axis=1)
         assert np.all(err <= 1e-9 * peak + 1e-9 * peak.max()), (err, peak)
+
+
+def test_output_times_outside_the_run_give_the_start_only():
+    # no output time inside (0, t_end]: the start alone, as solve_ivp's path (the loop once
+    # took the steps as output then and filled its buffer for ever)
+    m = _slider_crank()
+    s = SolverSettings(method="RK45")
+    for loop in (True, False):
+        r = integrate(m.system, m.q0, m.qd0, 0.002, np.array([0.0, 0.01]), s, compiled_loop=loop)
+        np.testing.assert_array_equal(r.t, [0.0])
+        assert r.y.shape == (2 * m.system.n + 6, 1)

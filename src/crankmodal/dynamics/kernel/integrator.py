@@ -55,7 +55,7 @@ DONE, WINDOW, TERMINAL, FULL, BUDGET, NONFINITE, SINGULAR, TOO_SMALL = range(8)
 _OK = -1
 # slots of the float state ``fs`` and the integer state ``ns``
 _T, _H, _TOLD, _TEND, _MAXSTEP, _RTOL, _TWIN, _TFAIL = range(8)
-_NFEV, _MAXNFEV, _NWIN, _IOUT, _NREC, _NOWN = range(6)
+_NFEV, _MAXNFEV, _NWIN, _IOUT, _NREC, _NOWN, _OWN = range(7)
 # event kinds (three events per clearance joint: 3 j + kind)
 ON, OFF, PEAK = 0, 1, 2
 #: evaluations between returns to Python (~0.1-0.5 s)
@@ -489,7 +489,7 @@ def _after_step(fs, ns, V, K, Qd, M, tab, ev, out, io_bufs):
         fs[_T] = t
         for i in range(y.size):
             y[i] = ytmp[i]
-    if t_out.size:
+    if ns[_OWN] == 0:
         while ns[_IOUT] < t_out.size and t_out[ns[_IOUT]] <= t:
             if not have_q:
                 _dense_coefficients(K, P, Qd)
@@ -517,7 +517,7 @@ def advance(fs, ns, V, K, Qd, atol, M, tab, ctl, ev, out, io_bufs):
             return DONE
         if fs[_T] >= fs[_TWIN] or ns[_NFEV] >= ns[_NWIN]:
             return WINDOW
-        if ns[_NREC] + n_ev > rec_cap or ns[_NOWN] + 1 > own_cap:
+        if ns[_NREC] + n_ev > rec_cap or (ns[_OWN] and ns[_NOWN] + 1 > own_cap):
             return FULL
         st = _step(fs, ns, V, K, atol, M, tab, ctl)
         if st != _OK:
@@ -589,7 +589,7 @@ def rhs(sysm, t, y, use_blocks: bool = True) -> np.ndarray:
     from ...errors import NumericalError
 
     dy = np.zeros(len(y))
-    fs, ns = np.zeros(8), np.zeros(6, np.int64)
+    fs, ns = np.zeros(8), np.zeros(7, np.int64)
     ns[_MAXNFEV] = 1
     code = _fun(float(t), np.ascontiguousarray(y, float), dy, model(sysm, use_blocks), fs, ns)
     if code != _OK:
@@ -657,7 +657,7 @@ def run(sysm, y0, t_end, t_out, settings, atol, pbar=None, guard=None):
     K = np.zeros((7, ny))
     Qd = np.zeros((ny, 4))
     fs = np.zeros(8)
-    ns = np.zeros(6, np.int64)
+    ns = np.zeros(7, np.int64)
     fs[_TEND], fs[_RTOL] = t_end, settings.rtol
     fs[_MAXSTEP] = np.inf if settings.max_step is None else settings.max_step
     ns[_MAXNFEV] = settings.max_rhs_evals
@@ -671,6 +671,7 @@ def run(sysm, y0, t_end, t_out, settings, atol, pbar=None, guard=None):
           np.zeros(ne, np.int64))
     out = np.zeros(_NDIAG)
     own = t_out is None
+    ns[_OWN] = int(own)
     t_out = np.zeros(0) if own else np.ascontiguousarray(t_out, float)
     y_out = np.zeros((t_out.size, ny))
     io_bufs = (t_out, y_out, np.zeros(_OWN_CAP), np.zeros((_OWN_CAP, ny)),
