@@ -18,8 +18,8 @@ so each factorisation is of an ``n`` square matrix (``n`` coordinates) instead o
 Everything around the step stays ``solve_ivp``'s: the output times, the contact events located
 on the dense output (SciPy's :class:`~scipy.integrate._ivp.radau.RadauDenseOutput` of the same
 ``Z``), and the right-hand side at each accepted step, which ``solve_ivp``'s function gives (the
-progress bar, the run budget and its early stop see it). The evaluations inside a step are
-added to ``Multibody.nfev``; the run budget (``max_rhs_evals``) counts them.
+progress bar and the run budget's early stop see that one evaluation per step). The evaluations
+inside a step are added to ``Multibody.nfev``; the run budget (``max_rhs_evals``) counts them.
 
 Trajectories equal SciPy's Radau with the compiled Jacobian up to round-off of the reduced
 linear algebra (the tests compare them sample by sample).
@@ -35,7 +35,8 @@ from scipy.integrate._ivp import radau as _radau
 from .compiled import N_AUX, drive_values, evaluate, flush_if_changed
 from .jacobian import _lu, _lu_solve, jacobian
 
-#: SciPy's Radau IIA constants: C, E, T, TI, TI_REAL, TI_COMPLEX, P; MU_REAL, MU_COMPLEX
+#: SciPy's Radau IIA constants C, E, T, TI, TI_REAL, TI_COMPLEX (its dense output's P stays
+#: SciPy's: RadauDenseOutput); then MU_REAL, MU_COMPLEX
 _K = (np.asarray(_radau.C, float), np.asarray(_radau.E, float),
       np.ascontiguousarray(_radau.T, float), np.ascontiguousarray(_radau.TI, float),
       np.asarray(_radau.TI_REAL, float), np.asarray(_radau.TI_COMPLEX, complex))
