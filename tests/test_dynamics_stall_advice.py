@@ -30,14 +30,14 @@ def test_a_flexible_body_on_ideal_joints_names_its_stiffest_mode(method):
     assert "after 200 right-hand-side evaluations" in text
     assert "tighten nothing" not in text
     assert "stiffest kept mode (2e+04 Hz of 'link') is the stiff part" in text
-    assert "use solver.method = 'Radau'" in text and "n_modes / cutoff_hz" in text
+    assert "use settings.method = 'Radau'" in text and "n_modes / cutoff_hz" in text
 
 
 def test_radau_is_told_to_raise_the_budget_or_drop_modes():
     sysm, _, q0 = _pendulum(1.0)
     text = _stall(sysm, q0, "Radau", 20)  # the finite-difference Jacobian alone takes more
     assert "(2e+04 Hz of 'link')" in text and "'Radau'" not in text
-    assert "raise solver.max_rhs_evals or keep fewer modes of 'link'" in text
+    assert "raise settings.max_rhs_evals or keep fewer modes of 'link'" in text
 
 
 def test_a_rigid_pendulum_keeps_the_ideal_joints_advice():
