@@ -92,8 +92,8 @@ def test_fig23_ideal_drive_power_is_the_energy_method_power(gravity):
     0/180/270/90 deg banks), 61.2 W; with gravity the unbalanced first-order mass adds
     g w r (2 m_p + m_r (4 - 2 a/l)) = g w 0.2688 kg m = 408.5 W at order 1. The dynamics
     (constraint multipliers times crank speed, integrated at rtol 1e-6) within 1e-4 of the
-    oracle's order amplitudes and half range: the integration and sampling error is ~1e-7
-    relative here, 1e-4 leaves room for any x86-64 CPU and tolerance choice."""
+    oracle's order amplitudes (integration error ~1e-7 relative here; 1e-4 leaves room for any
+    x86-64 CPU and tolerance choice) and 1e-3 of its half range (1-degree sampling)."""
     from crankmodal.dynamics.run.simulate import simulate
 
     mod = study()
@@ -109,7 +109,8 @@ def test_fig23_ideal_drive_power_is_the_energy_method_power(gravity):
     big = o_ref.max()
     for k in range(1, 9):
         assert abs(num[f"order_{k}"]["mean"] - o_ref[k - 1]) <= 1e-4 * big, (k, num, o_ref)
-    assert num["half_range"]["mean"] == pytest.approx(0.5 * np.ptp(oracle), rel=1e-4)
+    # the half range of 1-degree samples misses an order-4 peak by up to 1 - cos(2 deg) = 6.1e-4
+    assert num["half_range"]["mean"] == pytest.approx(0.5 * np.ptp(oracle), rel=1e-3)
     assert abs(num["mean"]["mean"]) <= 1e-4 * big
     if gravity:
         r, l = mp["crank_radius"], mp["rod_length"]
