@@ -33,7 +33,7 @@ steel = cm.material("steel")
 model = cm.assemble(rod, steel)
 itf = cm.make_interfaces(rod, [{"region": "big_end_bore", "kind": "distributing"},
                                {"region": "small_end_bore", "kind": "distributing"}])
-body, _ = cm.reduce_body(model, itf, n_modes=6, mesh=rod.mesh, name="rod")
+body, _ = cm.reduce_body(model, itf, fixed_interface_modes=6, mesh=rod.mesh, name="rod")
 body = cm.load_flexbody(cm.save_flexbody(work / "rod.npz", body))   # what another user receives
 vtu = export.write_modes_vtu(work / "rod_modes.vtu", body)
 print(f"{body.n_modes} modes ({len(body.elastic_frequencies_hz)} elastic); VTU for ParaView: "
