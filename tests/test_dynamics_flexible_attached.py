@@ -218,7 +218,9 @@ def test_quasi_static_loom_bends_the_rocker_as_a_cantilever_from_the_sley(rocker
     body = _rocker(rocker_file)
     delta, f_y = _quasi_static_bending(body, SLEY, crank_deg)
     closed = f_y * L ** 3 / (3 * 2.1e11 * t * w ** 3 / 12)
-    assert abs(f_y) > 1000.0
+    # 977 N at 240 deg since the start solves positions and modes together (1267 N before: the
+    # modes' accelerations were 27 m kg^0.5/s^2, within the omega^2-scaled tol, not at rest)
+    assert abs(f_y) > 900.0
     assert abs(delta) == pytest.approx(abs(closed), rel=2e-2)
     spread = copy.copy(body)
     spread.j0 = body.j0 + SLEY

@@ -3,15 +3,33 @@
 A flexible body started undeformed at full speed is struck by its own inertia and the applied
 loads at once: it rings through every kept mode, and the ringing decays only at the modal
 damping (2 %: e^-5 after 40 periods of the slowest mode). :func:`quasi_static_start` instead
-finds the elastic coordinates ``ξ`` at which the bodies' elastic accelerations vanish at
-``t = 0`` (the rigid coordinates re-assembled on the joints for each ``ξ``, the elastic
-velocities zero) by Newton's method with a finite-difference Jacobian, so a run starts where a
-slowly started machine would be.
+finds the state at which the bodies' elastic accelerations vanish at ``t = 0`` with the joints
+closed and the elastic velocities zero, so a run starts where a slowly started machine would be.
+
+The static problem is solved as one (the positions and the elastic coordinates together): a
+Gauss-Newton iteration on ::
+
+    F(q) = [ Φ(q, t) ;  q̈_ξ(q, q̇(q)) / ω² ] = 0
+
+where ``Φ`` are the joint equations, ``q̈_ξ`` the elastic accelerations of the system's KKT
+solve (the multipliers are the joint reactions of the static problem, the drive's speed gives
+the centrifugal and inertia terms) and ``q̇(q)`` the builder's velocities made consistent with
+the joints at ``q`` (elastic velocities zero). A crank bent over three or more journals has
+to close its journals *through* its elastic coordinates: holding the modes while assembling
+the joints (this function's former way) cannot close them. Each step is the least-squares,
+least-change solution of the linearised equations (Jacobian: ``Φ_q`` exactly, the elastic
+rows by forward differences), so coordinates the equations leave free (a free crank angle, a
+coupling's twist) stay where the builder put them.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from ...errors import NumericalError
+
+#: joint equations closed below this, m or rad (what Multibody.assemble asks of a start)
+PHI_TOL = 1e-12
 
 
 def _elastic_columns(sysm) -> np.ndarray:
@@ -24,8 +42,18 @@ def _elastic_columns(sysm) -> np.ndarray:
     return np.array(cols, int)
 
 
+def _steps(q: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Forward-difference steps per coordinate: 1e-8 of the rigid coordinates' size (m, rad;
+    at least 1e-8), 1e-6 of the largest elastic coordinate (at least 1e-12 m kg^½: the
+    elastic rows are close to linear in ξ, so a large step costs nothing and keeps the
+    rounding of the KKT solve out of the Jacobian)."""
+    h = 1e-8 * np.maximum(1.0, np.abs(q))
+    h[cols] = 1e-6 * max(1e-6, float(np.max(np.abs(q[cols]))))
+    return h
+
+
 def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
-    """Elastic coordinates at quasi-static rest at time ``t`` (see the module docstring).
+    """State at quasi-static rest at time ``t`` (see the module docstring).
 
     What scenes do before a run with flexible bodies (``dynamics.flexible.start =
     "quasi_static"``, the default) and :func:`~.analysis.simulate` does by default
@@ -39,25 +67,28 @@ def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
     ----------
     sysm : Multibody
     q, qd : arrays
-        A consistent state (e.g. the builder's, bodies undeformed).
+        A state (e.g. the builder's, bodies undeformed); the velocities of the coordinates the
+        joints leave free are kept.
     t : float
         Time of the state, s.
     tol : float
         Stop when the elastic accelerations, each divided by its mode's ω², are below this
-        (modal coordinate, m kg^½), > 0.
+        (modal coordinate, m kg^½), > 0, and the joints are closed (1e-12 m or rad).
     max_iter : int
         Newton iterations at most, >= 1.
 
     Returns
     -------
-    q, qd, info : the state (elastic velocities zero, rigid coordinates re-assembled on the
-        joints) and ``{"iterations", "residual"}``; ``q`` and ``qd`` as given (copies) without
-        elastic modes.
+    q, qd, info : the state (elastic velocities zero, joints closed, velocities consistent)
+        and ``{"iterations", "residual"}`` (the largest elastic residual, m kg^½); ``q`` and
+        ``qd`` as given (copies) without elastic modes.
 
     Raises
     ------
     ParameterError
         Naming ``q``, ``qd`` (not ``sysm.n`` finite numbers), ``t``, ``tol`` or ``max_iter``.
+    NumericalError
+        When the joints cannot be closed (the state's joints are not near a closed state).
     """
     from ... import arguments as arg
 
@@ -68,36 +99,46 @@ def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
     max_iter = arg.integer("max_iter", max_iter, ge=1)
     cols = _elastic_columns(sysm)
     if cols.size == 0:
-        return q, qd, {"iterations": 0, "residual": 0.0}
+        return np.array(q), np.array(qd), {"iterations": 0, "residual": 0.0}
     qd = np.array(qd, float)
     qd[cols] = 0.0
     w2 = np.concatenate([b.K[:b.n_elastic] for b in sysm.bodies if getattr(b, "n_elastic", 0)])
 
-    def residual(xi):
-        qq = np.array(q, float)
-        qq[cols] = xi
-        qq, qqd = sysm.assemble(t, qq, qd, hold=cols)
-        return sysm.solve(t, qq, qqd)["qdd"][cols] / w2, qq, qqd  # the static error in ξ
+    def residual(qq):
+        # velocities made consistent at qq without moving it (tol = inf: no position step)
+        _, qqd = sysm.assemble(t, qq, qd, tol=np.inf, hold=cols)
+        out = sysm.solve(t, qq, qqd)
+        return np.concatenate([out["phi"], out["qdd"][cols] / w2]), out["Cq"]
 
-    xi = np.array(q[cols], float)
-    r, qq, qqd = residual(xi)
+    m = sysm.m
+    q = np.array(q, float)
+    F, Cq = residual(q)
     it = 0
     for it in range(1, max_iter + 1):
         # at least one Newton step: scaled by ω², the undeformed state of a stiff link (a
         # 17 kHz coupler carrying kN) is already "within tol" while its joints carry almost
         # nothing (the elastic accelerations, not the springs, balance the loads at t = 0)
-        if it > 1 and np.max(np.abs(r)) < tol:
+        if it > 1 and np.max(np.abs(F[m:])) < tol and np.max(np.abs(F[:m]), initial=0.0) < \
+                PHI_TOL:
             it -= 1
             break
-        h = 1e-7 * max(1e-6, float(np.max(np.abs(xi))))
-        J = np.empty((cols.size, cols.size))
-        for j in range(cols.size):
-            e = np.zeros(cols.size)
-            e[j] = h
-            J[:, j] = (residual(xi + e)[0] - r) / h
-        xi = xi - np.linalg.solve(J, r)
-        r, qq, qqd = residual(xi)
-    return qq, qqd, {"iterations": it, "residual": float(np.max(np.abs(r)))}
+        h = _steps(q, cols)
+        J = np.empty((m + cols.size, sysm.n))
+        J[:m] = Cq
+        for j in range(sysm.n):
+            qq = q.copy()
+            qq[j] += h[j]
+            J[m:, j] = (residual(qq)[0][m:] - F[m:]) / h[j]
+        q = q - np.linalg.lstsq(J, F, rcond=None)[0]
+        F, Cq = residual(q)
+    if np.max(np.abs(F[:m]), initial=0.0) > 1e3 * PHI_TOL:
+        raise NumericalError(
+            f"dynamics: the quasi-static start did not close the joints at t = {t} s (residual "
+            f"{np.max(np.abs(F[:m])):.1e} after {it} Newton steps); start the flexible bodies "
+            f"undeformed or check the assembly")
+    q, qd = sysm.assemble(t, q, qd, hold=cols)  # the last 1e-12 of the joints; the velocities
+    r = residual(q)[0][m:]
+    return q, qd, {"iterations": it, "residual": float(np.max(np.abs(r)))}
 
 
 __all__ = ["quasi_static_start"]
