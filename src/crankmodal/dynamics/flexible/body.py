@@ -115,7 +115,7 @@ class FlexibleBody:
 
     def __init__(self, name, mass, j0, centre, frequencies_hz, G, b, S, interfaces,
                  damping_ratio=DEFAULT_DAMPING, z=0.0, info=None, c=None, n_tilt=0,
-                 orientation=0.0, source=None):
+                 orientation=0.0, source=None, Gz=None):
         self.name = name
         self.mass = float(mass)
         self.j0 = float(j0)
@@ -134,6 +134,9 @@ class FlexibleBody:
         self.b = np.asarray(b, float).reshape(k)
         self.S = np.asarray(S, float).reshape(k, k)
         self.c = np.zeros(k) if c is None else np.asarray(c, float).reshape(k)
+        #: axial (z) modal mass of the modes and tilts, constant (:func:`axial_mass`; zero
+        #: unless the body was made with ``axial_inertia``), added with the attached inertias
+        self.Gz = np.zeros((k, k)) if Gz is None else np.asarray(Gz, float).reshape(k, k)
         self.orientation = float(orientation)
         co, so = np.cos(-self.orientation), np.sin(-self.orientation)
         R = np.array([[co, -so], [so, co]])  # part x-y axes -> body axes
@@ -176,9 +179,10 @@ class FlexibleBody:
 
     def attached_terms(self) -> tuple[float, np.ndarray, np.ndarray]:
         """The attached inertias' constant mass terms: ``Σ J_s`` (θ, θ), ``Σ J_s r_z`` (θ, ξ;
-        shape (k,)) and ``Σ J_s r_z r_zᵀ`` (ξ, ξ; shape (k, k)), kg m², kg m² per ξ, …"""
+        shape (k,)) and ``Σ J_s r_z r_zᵀ`` (ξ, ξ; shape (k, k)), kg m², kg m² per ξ, …; the
+        (ξ, ξ) block also holds the constant axial modal mass ``Gz`` (:func:`axial_mass`)."""
         k = self.n_coordinates
-        h, H = np.zeros(k), np.zeros((k, k))
+        h, H = np.zeros(k), self.Gz.copy()  # the axial modal mass: constant as well
         for frame, J in self.attached:
             rz = self.frames[frame][2]
             h += J * rz
@@ -203,6 +207,7 @@ class FlexibleBody:
         for a in ("zeta", "K", "C", "b", "c"):
             setattr(twin, a, getattr(self, a)[keep])
         twin.G, twin.S = self.G[np.ix_(keep, keep)], self.S[np.ix_(keep, keep)]
+        twin.Gz = self.Gz[np.ix_(keep, keep)]
         twin.frames = {n: (s0, D[:, keep], rz[keep]) for n, (s0, D, rz) in self.frames.items()}
         twin.info = dict(self.info, rigid_twin=True)
         return twin
@@ -222,7 +227,7 @@ class FlexibleBody:
         M[2, 3:] = h
         M[3:, 2] = h
         M[3:, 3:] = self.G
-        if self.attached:
+        if self.attached or self.Gz.any():
             Js, h, H = self.attached_terms()
             M[2, 2] += Js
             M[2, 3:] += h
@@ -377,7 +382,8 @@ def planar_body(fb, name: str, n_modes: int | None = None,
                        cutoff_hz: float | None = None,
                        damping_ratio=DEFAULT_DAMPING, interfaces=None,
                        min_in_plane: float = MIN_IN_PLANE, z: float = 0.0, tilt: bool = False,
-                       orientation: float = 0.0, path=None) -> FlexibleBody:
+                       orientation: float = 0.0, path=None,
+                       axial_inertia: bool = False) -> FlexibleBody:
     """A planar :class:`FlexibleBody` from a reduced body (:func:`crankmodal.reduction.io.load_flexbody`).
 
     Several planar bodies (four rods) can be made from one reading of the file.
@@ -409,6 +415,11 @@ def planar_body(fb, name: str, n_modes: int | None = None,
         direction, so that the frame angle is the crank angle).
     path : str or Path, optional
         The file it was read from (error messages and provenance).
+    axial_inertia : bool
+        Also count the kinetic energy of the modes' and tilts' axial (z) motion
+        (:func:`axial_mass`): exact for a body turning about z, it gives the linearised planar
+        body the 3D body's frequencies (a crank's flywheel rocking, torsion with web axial
+        motion). Default False (the plane restriction of the module docstring).
 
     Raises
     ------
@@ -479,6 +490,7 @@ def planar_body(fb, name: str, n_modes: int | None = None,
     centres = np.asarray(fb.interface_centres, float)
     zeta = np.broadcast_to(zeta, (k,)) if zeta.ndim else np.full(k, float(zeta))
     n_tilt = 0
+    Gz = axial_mass(inv, keep, np.asarray(fb.inertia, float), tilt) if axial_inertia else None
     if tilt:
         I8 = np.asarray(inv["I8"])[:, :, keep]
         G, b, S, c, imap = tilt_terms(G, b, S, c, imap, I8, np.asarray(fb.inertia, float),
@@ -491,10 +503,41 @@ def planar_body(fb, name: str, n_modes: int | None = None,
         centre=fb.centre_of_mass, frequencies_hz=freq, G=G, b=b, S=S, c=c,
         interfaces={n: (centres[i], imap[i]) for i, n in enumerate(names)},
         damping_ratio=zeta, z=z, n_tilt=n_tilt, orientation=orientation,
-        source=fb,
+        source=fb, Gz=Gz,
         info={"file": str(path), "part": fb.name, "left_out": left,
               "mode_columns": cols.tolist(),
               "interface_centres": {n: centres[i].tolist() for i, n in enumerate(names)}})
+
+
+def axial_mass(inv, keep, inertia, tilt: bool) -> np.ndarray:
+    """The axial (z) modal mass of the kept modes (and of the two tilts, with ``tilt``).
+
+    A body turning about z moves a point axially by ``w = Φ_z ξ (+ α_x ȳ − α_y x̄)``, in body
+    axes; rotation about z leaves the axial velocity ``ẇ`` unchanged, so its kinetic energy is
+    ``½ q̇ᵀ Gz q̇`` with a constant ``Gz`` and no centrifugal or Coriolis term (as an attached
+    inertia's). From the invariants of :mod:`crankmodal.reduction.flexbody` and the inertia
+    tensor ``I`` about the centre of mass (``∫ρ x_j φ_a,i = δ_ij ∫ρ x·φ_a − I8[i, j, a]``)::
+
+        Gz[a, b] = I6[a, b] − I9[2, 2, a, b]        (∫ρ φ_a,z φ_b,z)
+        Gz[tx, tx] = ∫ρ ȳ² = (I_xx + I_zz − I_yy) / 2,  Gz[ty, ty] = (I_yy + I_zz − I_xx) / 2,
+        Gz[tx, ty] = −∫ρ x̄ȳ = I_xy,  Gz[tx, a] = −I8[2, 1, a],  Gz[ty, a] = I8[2, 0, a]
+
+    Returns an array (k, k), or (k + 2, k + 2) with the tilts last (x, y) as :func:`tilt_terms`.
+    """
+    I6 = np.asarray(inv["I6"])[np.ix_(keep, keep)]
+    Gz = I6 - np.asarray(inv["I9"])[2, 2][np.ix_(keep, keep)]
+    if not tilt:
+        return Gz
+    k = len(keep)
+    I8 = np.asarray(inv["I8"])[:, :, keep]
+    out = np.zeros((k + 2, k + 2))
+    out[:k, :k] = Gz
+    out[k, k] = 0.5 * (inertia[0, 0] + inertia[2, 2] - inertia[1, 1])
+    out[k + 1, k + 1] = 0.5 * (inertia[1, 1] + inertia[2, 2] - inertia[0, 0])
+    out[k, k + 1] = out[k + 1, k] = inertia[0, 1]
+    out[k, :k] = out[:k, k] = -I8[2, 1]
+    out[k + 1, :k] = out[:k, k + 1] = I8[2, 0]
+    return out
 
 
 def tilt_terms(G, b, S, c, imap, I8, inertia, com, centres):
@@ -540,4 +583,5 @@ def tilt_terms(G, b, S, c, imap, I8, inertia, com, centres):
     return G2, b2, S2, c2, im2
 
 
-__all__ = ["DEFAULT_DAMPING", "FlexibleBody", "load_flexible_body", "planar_body", "tilt_terms"]
+__all__ = ["DEFAULT_DAMPING", "FlexibleBody", "axial_mass", "load_flexible_body", "planar_body",
+           "tilt_terms"]

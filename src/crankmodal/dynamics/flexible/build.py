@@ -319,10 +319,14 @@ def crank_body(source, spec: dict | None = None, row_z=None, crank_radius: float
         pins.append(th["bands"][int(np.argmin(dz))])
     drive = "flywheel_end_face" if "flywheel_end_face" in centres else mains[0]
     arm1 = np.deg2rad(info[0]["angle_deg"])
+    # every stored mode is offered, with its axial kinetic energy: a crank's modes that move
+    # mostly axially (flywheel rocking, webs in the throw plane) still move its journals and
+    # pins in the plane, and on three or more journals their flexibility decides the split
     with arg.prefixed("spec"):  # planar_body names n_modes: here it is spec's
         body = planar_body(fb, name, n_modes=spec.get("n_modes"),
                            cutoff_hz=spec.get("cutoff_hz"), damping_ratio=spec["damping_ratio"],
-                           tilt=len(mains) > 1, orientation=float(arm1), path=path)
+                           tilt=len(mains) > 1, orientation=float(arm1), path=path,
+                           min_in_plane=0.0, axial_inertia=True)
     roles = {"mains": [], "pins": [], "drive": "drive"}
     for j, n in enumerate(mains, start=1):
         body.alias(f"main_{j}", n)
