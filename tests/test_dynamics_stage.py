@@ -161,7 +161,11 @@ def test_impact_peaks_do_not_depend_on_the_output_step(tmp_path):
     assert jf["impact_count"] > 3
     assert jc["peak_contact_force_n"] == pytest.approx(jf["peak_contact_force_n"], rel=1e-9)
     assert jc["max_penetration_m"] == pytest.approx(jf["max_penetration_m"], rel=1e-9)
-    assert coarse_arr["contact_big_end_1_fn"].max() < 0.9 * jc["peak_contact_force_n"]  # 0.83
+    # the samples of the same window miss most of the peak (the whole run's samples may not:
+    # the start-up's impacts, left out of the peaks, can be the deepest of a trajectory)
+    lo_c, hi_c = coarse["peak_window_s"]
+    in_c = (coarse_arr["t"] >= lo_c) & (coarse_arr["t"] <= hi_c)
+    assert coarse_arr["contact_big_end_1_fn"][in_c].max() < 0.9 * jc["peak_contact_force_n"]
     # the peaks are those of the results window (issue 25: the start-up is not a result)
     lo, hi = fine["peak_window_s"]
     inside = (fine_arr["t"] >= lo) & (fine_arr["t"] <= hi)
