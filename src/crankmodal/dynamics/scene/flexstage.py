@@ -18,9 +18,6 @@ import numpy as np
 
 from ...errors import SceneError, scene_keys
 
-#: output samples processed at once when the stress modes are superposed
-STRESS_CHUNK = 64
-
 
 def train_geometry(p, mechanism_params):
     """Crank radius (m), rod lengths (m) and row positions (m) of the crank train."""
@@ -243,7 +240,7 @@ def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict 
     holds no stress modes.
     """
     from ...reduction.io import load_flexbody
-    from ...reduction.stress_modes import von_mises
+    from ..results.peak_stress import peak_von_mises
 
     fb = body.source if body.source is not None else load_flexbody(body.info["file"])
     modes = getattr(fb, "stress_modes", None)
@@ -251,25 +248,15 @@ def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict 
         return None
     cols = np.asarray(body.info["mode_columns"], int)
     S = np.asarray(modes[:, :, cols], float)  # (p, 6, k)
-    xi = modal[:, :body.n_elastic]
-    best = np.zeros(S.shape[0])
-    when = np.zeros(S.shape[0], int)
-    for k0 in range(0, len(t), STRESS_CHUNK):
-        sig = np.einsum("pik,tk->tpi", S, xi[k0:k0 + STRESS_CHUNK])
-        vm = von_mises(sig, axis=-1)
-        i = np.argmax(vm, axis=0)
-        v = vm[i, np.arange(vm.shape[1])]
-        better = v > best
-        best[better], when[better] = v[better], k0 + i[better]
-    p = int(np.argmax(best))
-    k = int(when[p])
-    out = {"max_von_mises_pa": float(best[p]),
+    # the points whose seminorm bound can exceed the largest found only (.peak_stress)
+    best, p, k, _ = peak_von_mises(S, modal[:, :body.n_elastic])
+    out = {"max_von_mises_pa": best,
            "location_m": np.asarray(fb.stress_points)[p].tolist(),
            "time_s": float(t[k]),
            "crank_angle_deg": float(np.rad2deg(crank_angle[k]) % 360.0),
            "n_points": int(S.shape[0]), "n_modes": int(S.shape[2])}
     if material_strength:
-        out["safety_factor"] = float(material_strength / best[p]) if best[p] > 0 else None
+        out["safety_factor"] = float(material_strength / best) if best > 0 else None
     return out
 
 
