@@ -81,6 +81,14 @@ def test_a_bad_law_parameter_by_name_names_the_argument():
     with pytest.raises(ParameterError) as err:
         ClearanceJoint("c", b, "p", g, "o", 1e-4, 0.02)
     assert err.value.argument == "law"
+    # the joint checks its geometry by ClearanceSpec's rules
+    for kw, argument in (({"clearance": -1e-4}, "clearance"), ({"journal_radius": 0.0},
+                                                               "journal_radius"),
+                         ({"film_model": "long"}, "film_model")):
+        args = dict({"clearance": 1e-4, "journal_radius": 0.02}, **kw)
+        with pytest.raises(ParameterError) as err:
+            ClearanceJoint("c", b, "p", g, "o", law=LAW, **args)
+        assert err.value.argument == argument
 
 
 SCENE = """

@@ -245,9 +245,14 @@ class ClearanceJoint:
                                    float(self.clearance_major), float(self.wear_angle))
 
     def __post_init__(self):
-        if self.film_model not in FILM_MODELS:
-            raise ParameterError("film_model", f"must be one of {', '.join(FILM_MODELS)}; got "
-                                 f"{self.film_model!r}")
+        from ... import arguments as arg
+
+        for name, rule in RULES.items():  # the rules ClearanceSpec and the scene keys share
+            value = getattr(self, name)
+            if name == "bearing_length" and not value:  # 0: no film
+                continue
+            setattr(self, name, arg.check(name, value, rule,
+                                          optional=rule.default is not REQUIRED))
         if self.law is None:
             raise ParameterError("law", "is required: a NormalLaw (e.g. Impact(...), or "
                                  "make_law(name, params))")
