@@ -115,13 +115,40 @@ def test_quasi_static_start_on_three_journals_gives_the_static_condensation_reac
     assert np.abs(xi).max() > 1e-6  # it did bend
 
 
+def test_quasi_static_start_of_a_torque_driven_train_keeps_its_free_angles(seed004):
+    """Seed 004's scene set-up (motor through the coupling, constant motor torque: the train's
+    angle and the coupling's twist are free): the start converges (elastic residual < 1e-9,
+    seen 2e-17 in 2 steps) and leaves the free angles where the builder put them (seen
+    4e-9 rad). Unweighted least-change steps turned the crank by 0.7 rad; NumPy's default
+    cut-off in the velocity projection made a 156 rad/s step and stalled at 1e-4."""
+    from crankmodal.dynamics.model.drive import MotorDrive
+
+    body, roles = _crank(seed004, n_modes=12)
+    mech = crank_train(seed004.crank_radius, seed004.cylinders, seed004.speed_rpm,
+                       direction=-1, arrangement=seed004.arrangement, crank_body=body,
+                       crank_roles=roles, motor=MotorDrive(0.10, 1.5e4, 6.0),
+                       drive_torque=-95.76)
+    q0, qd0 = mech.q0.copy(), mech.qd0.copy()
+    info = mech.start_quasi_static()
+    assert info["residual"] < 1e-9
+    sysm = mech.ideal
+    im = sysm.slices[id(mech.motor)].start + 2
+    assert abs(mech.q0[2] - q0[2]) < 1e-6 and abs(mech.q0[im] - q0[im]) < 1e-6
+    assert mech.qd0[im] == pytest.approx(qd0[im], rel=1e-12)
+    out = sysm.solve(0.0, mech.q0, mech.qd0)
+    assert np.abs(out["phi"]).max() < 1e-12
+    _, Cq, nu, _ = sysm.constraint_terms(0.0, mech.q0, mech.qd0)
+    assert np.abs(Cq @ mech.qd0 - nu).max() < 1e-9
+    assert np.abs(mech.q0[3:3 + body.n_elastic]).max() > 1e-6
+
+
 def _ringing(X, freqs, dt):
     """Per mode, the largest departure of its coordinate from its moving mean over one period
     of the mode (the ringing at the mode's frequency; the slow quasi-static motion at orders
     1-2 of the revolution passes the mean), m kg^½."""
     out = []
     for a, f in enumerate(freqs):
-        w = max(1, int(round(1.0 / (f * dt))))
+        w = max(1, round(1.0 / (f * dt)))
         mean = np.convolve(X[:, a], np.ones(w) / w, mode="same")
         out.append(np.abs(X[w:-w, a] - mean[w:-w]).max())
     return np.array(out)
@@ -147,3 +174,78 @@ def test_quasi_static_start_on_three_journals_removes_the_start_up_ringing(seed0
         peak[start] = np.hypot(*h.joint_forces["main_2"].T).max()
     assert np.all(ring["quasi_static"] < 0.1 * ring["undeformed"])
     assert peak["quasi_static"] < 0.2 * peak["undeformed"]
+
+
+# ------------------------------------------------------------- frozen modes on two journals
+def test_frozen_modes_on_two_journals_give_the_rigid_crank_train(seed004):
+    """The crank with no elastic mode (its two tilts only) on its outer journals 1 and 3, seed
+    004's cylinders with gas at 1494.6 rpm, one revolution, against a RigidBody crank with the
+    same mass, polar moment and frames on one main joint: the total main-bearing force and
+    the drive torque within 1e-9 of their peaks (seen 1.5e-11, 3e-11). Each journal's force
+    against the rigid run's lever rule (rods' forces at their throws, the rest at the centre
+    of mass) plus the couple of the crank's FE inertia tensor about its centre of mass
+    (Euler: M = (I_xz α - I_yz ω², I_yz α + I_xz ω²), carried by the journal pair): within
+    1e-9 of the total's peak (seen 2e-11; without the couple 0.63)."""
+    from crankmodal.dynamics.model.bodies import RigidBody
+    from crankmodal.dynamics.results.journals import journal_forces
+    from crankmodal.reduction.io import load_flexbody
+
+    body, roles = _crank(seed004, n_modes=0)
+    assert body.n_elastic == 0 and body.n_tilt == 2
+    frames = {n: tuple(body.frames[n][0]) for n in ["main_1", "drive"] + roles["pins"]}
+    rigid = RigidBody("crank", body.mass, body.j0, frames)
+    rev = seed004.speed_rpm / 60.0
+    settings = SolverSettings(method="RK45", rtol=1e-11, atol=1e-14)
+
+    def run(crank, crank_roles):
+        mech = crank_train(seed004.crank_radius, seed004.cylinders, seed004.speed_rpm,
+                           direction=-1, arrangement=seed004.arrangement, crank_body=crank,
+                           crank_roles=crank_roles)
+        return mech, simulate(mech, 1.0 / rev, 1.0 / (360.0 * rev), settings, ideal=True)
+
+    _, hf = run(body, dict(roles, mains=["main_1", "main_3"]))
+    mr, hr = run(rigid, {"mains": ["main_1"], "pins": roles["pins"], "drive": "drive"})
+    f, g = hf.main_bearing_force, hr.main_bearing_force
+    peak = np.hypot(*g.T).max()
+    assert peak > 1e4
+    assert np.abs(f - g).max() < 1e-9 * peak
+    assert np.abs(hf.drive_torque - hr.drive_torque).max() < 1e-9 * np.abs(hr.drive_torque).max()
+    # per journal: the lever rule on the rigid run, in the body's axial coordinates
+    fb = load_flexbody(seed004.path)
+    z1, z3 = body.info["mains_z_m"][0], body.info["mains_z_m"][2]
+    mr.journals_z = [z1, z3]
+    mr.rows_z = {f"big_end_{i}": t["z_m"] for i, t in enumerate(body.info["throws"], start=1)}
+    mr.crank.z = float(fb.centre_of_mass[2])
+    lever = journal_forces(mr, hr)
+    inertia = np.asarray(fb.inertia, float)  # tensor: off-diagonals are -∫x z dm
+    w, a, th = hr.crank_speed, hr.angular_acceleration["crank"], hr.crank_angle
+    mx = inertia[0, 2] * a - inertia[1, 2] * w ** 2  # body axes, the moment on the crank
+    my = inertia[1, 2] * a + inertia[0, 2] * w ** 2
+    c, s = np.cos(th), np.sin(th)
+    moment = np.column_stack([c * mx - s * my, s * mx + c * my])
+    # a pair +Q at journal 3, -Q at journal 1 on the crank: (z3 - z1) e_z x Q = M
+    pair = np.column_stack([moment[:, 1], -moment[:, 0]]) / (z3 - z1)
+    for name, expected in (("main_1", lever["main_1"] + pair),
+                           ("main_2", lever["main_2"] - pair)):
+        assert np.abs(hf.joint_forces[name] - expected).max() < 1e-9 * peak
+    assert np.abs(pair).max() > 0.1 * peak  # the couple matters
+
+
+# ------------------------------------------------------------------------------- energy
+def test_energy_closes_with_the_strain_energy_on_three_journals(seed004):
+    """Seed 004's flexible crank on three journals (12 modes, undamped), gas and inertia at
+    1494.6 rpm, started undeformed so that the modes ring: kinetic + strain energy change by
+    the drive's and the gas forces' work alone: residual under 1e-6 of the energy exchanged
+    (seen 1e-11), while the strain energy reaches 1.5e-3 of it (the residual without it)."""
+    body, roles = _crank(seed004, n_modes=12, damping_ratio=0.0)
+    mech = crank_train(seed004.crank_radius, seed004.cylinders, seed004.speed_rpm,
+                       direction=-1, arrangement=seed004.arrangement, crank_body=body,
+                       crank_roles=roles)
+    rev = seed004.speed_rpm / 60.0
+    h = simulate(mech, 0.5 / rev, 1.0 / (720.0 * rev),
+                 SolverSettings(method="RK45", rtol=1e-10, atol=1e-13), ideal=True,
+                 start="undeformed")
+    e = h.energy
+    assert e["strain"].max() > 5e-4 * h.energy_scale()
+    assert e["dissipated_modal"][-1] == 0.0
+    assert h.energy_error() < 1e-6

@@ -241,9 +241,12 @@ class Multibody:
         return dy
 
     # ----------------------------------------------------------------- initial state
-    def assemble(self, t, q0, qd0, tol=1e-12, max_iter=30, hold=()):
+    def assemble(self, t, q0, qd0, tol=1e-12, max_iter=30, hold=(), rcond=None):
         """Consistent positions and velocities close to ``q0``, ``qd0`` (least-change Newton);
-        the coordinates in ``hold`` (indices) keep their positions and velocities."""
+        the coordinates in ``hold`` (indices) keep their positions and velocities. ``rcond``:
+        the velocity step's cut-off of small singular values relative to the largest (NumPy's
+        ``lstsq``; default machine precision): a free direction left by the held coordinates
+        (a torque-driven crank's rotation with its modes held) must not be "corrected"."""
         q = np.array(q0, float)
         free = np.setdiff1d(np.arange(self.n), np.asarray(hold, int))
         for _ in range(max_iter):
@@ -260,7 +263,7 @@ class Multibody:
         _, Cq, nu, _ = self.constraint_terms(t, q, np.zeros(self.n))
         qd = np.array(qd0, float)
         if self.m:
-            qd[free] -= np.linalg.lstsq(Cq[:, free], Cq @ qd - nu, rcond=None)[0]
+            qd[free] -= np.linalg.lstsq(Cq[:, free], Cq @ qd - nu, rcond=rcond)[0]
         return q, qd
 
 
