@@ -199,6 +199,39 @@ def yield_strength(body) -> tuple[float | None, str | None]:
         return None, str(name)
 
 
+def flexible_bodies_of(mech) -> list:
+    """The mechanism's bodies with elastic coordinates."""
+    return [b for b in mech.system.bodies if getattr(b, "n_elastic", 0) > 0]
+
+
+def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict | None:
+    """Largest von Mises stress of a flexible body over a run, from its stress modes.
+
+    ``σ(t) = Σ_a σ_a ξ_a(t)`` over the kept elastic modes (Pa per unit ξ, stored by the
+    reduction at the mesh nodes); the rigid tilts carry no stress. Returns None when the file
+    holds no stress modes.
+    """
+    from ...reduction.io import load_flexbody
+    from .peak_stress import peak_von_mises
+
+    fb = body.source if body.source is not None else load_flexbody(body.info["file"])
+    modes = getattr(fb, "stress_modes", None)
+    if modes is None or body.n_elastic == 0:
+        return None
+    cols = np.asarray(body.info["mode_columns"], int)
+    S = np.asarray(modes[:, :, cols], float)  # (p, 6, k)
+    # the points whose seminorm bound can exceed the largest found only (.peak_stress)
+    best, p, k, _ = peak_von_mises(S, modal[:, :body.n_elastic])
+    out = {"max_von_mises_pa": best,
+           "location_m": np.asarray(fb.stress_points)[p].tolist(),
+           "time_s": float(t[k]),
+           "crank_angle_deg": float(np.rad2deg(crank_angle[k]) % 360.0),
+           "n_points": int(S.shape[0]), "n_modes": int(S.shape[2])}
+    if material_strength:
+        out["safety_factor"] = float(material_strength / best) if best > 0 else None
+    return out
+
+
 def flexible_validity(body, deflection: dict | None, stress: dict | None, key: str,
                       fraction: float = DEFLECTION_FRACTION) -> tuple[dict, list[str]]:
     """Whether a flexible body stayed inside the linear floating-frame model: its elastic
@@ -211,7 +244,7 @@ def flexible_validity(body, deflection: dict | None, stress: dict | None, key: s
     deflection : dict or None
         :func:`elastic_deflection`.
     stress : dict or None
-        :func:`.flexstage.dynamic_stress` (``max_von_mises_pa``), None without stress modes.
+        :func:`dynamic_stress` (``max_von_mises_pa``), None without stress modes.
     key : str
         The body's scene table (``dynamics.flexible.coupler``), named in the warnings.
 
@@ -306,7 +339,6 @@ def check_flexible_bodies(mech, hist, t_start: float = 0.0, warnings: list | Non
         Body name -> validity block (:func:`flexible_validity`).
     """
     from ...errors import warn
-    from ..scene.flexstage import dynamic_stress, flexible_bodies_of
 
     sel = np.asarray(hist.t) >= t_start
     t = np.asarray(hist.t)[sel]

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import SceneError, scene_keys
+from ..results.validity import dynamic_stress, flexible_bodies_of
 
 
 def train_geometry(p, mechanism_params):
@@ -192,11 +193,6 @@ def flexible_key(body_name: str) -> str:
     return "dynamics.flexible." + ("rods" if body_name.startswith("rod_") else body_name)
 
 
-def flexible_bodies_of(mech) -> list:
-    """The mechanism's bodies with elastic coordinates."""
-    return [b for b in mech.system.bodies if getattr(b, "n_elastic", 0) > 0]
-
-
 def _rms(x):
     return float(np.sqrt(np.mean(np.asarray(x) ** 2)))
 
@@ -229,34 +225,6 @@ def interface_deflections(body, modal) -> dict:
         D = body.frames[name][1]
         u = modal[:, :k] @ D[:, :k].T
         out[name] = float(np.hypot(u[:, 0], u[:, 1]).max())
-    return out
-
-
-def dynamic_stress(body, modal, t, crank_angle, material_strength=None) -> dict | None:
-    """Largest von Mises stress of a flexible body over a run, from its stress modes.
-
-    ``σ(t) = Σ_a σ_a ξ_a(t)`` over the kept elastic modes (Pa per unit ξ, stored by the
-    reduction at the mesh nodes); the rigid tilts carry no stress. Returns None when the file
-    holds no stress modes.
-    """
-    from ...reduction.io import load_flexbody
-    from ..results.peak_stress import peak_von_mises
-
-    fb = body.source if body.source is not None else load_flexbody(body.info["file"])
-    modes = getattr(fb, "stress_modes", None)
-    if modes is None or body.n_elastic == 0:
-        return None
-    cols = np.asarray(body.info["mode_columns"], int)
-    S = np.asarray(modes[:, :, cols], float)  # (p, 6, k)
-    # the points whose seminorm bound can exceed the largest found only (.peak_stress)
-    best, p, k, _ = peak_von_mises(S, modal[:, :body.n_elastic])
-    out = {"max_von_mises_pa": best,
-           "location_m": np.asarray(fb.stress_points)[p].tolist(),
-           "time_s": float(t[k]),
-           "crank_angle_deg": float(np.rad2deg(crank_angle[k]) % 360.0),
-           "n_points": int(S.shape[0]), "n_modes": int(S.shape[2])}
-    if material_strength:
-        out["safety_factor"] = float(material_strength / best) if best > 0 else None
     return out
 
 
