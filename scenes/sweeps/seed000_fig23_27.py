@@ -179,8 +179,12 @@ def ensemble_of(rows: list[dict]) -> dict:
     return out
 
 
-def run_case(sc, n_traj: int, log=print) -> dict:
-    """The ideal-joint twin (one trajectory: smooth) and ``n_traj`` clearance trajectories."""
+def run_case(sc, n_traj: int, log=print, histories: Path | None = None) -> dict:
+    """The ideal-joint twin (one trajectory: smooth) and ``n_traj`` clearance trajectories.
+
+    ``histories``: an ``.npz`` file to write the drive power of the ideal twin and of the
+    first trajectory to (``t`` s, ``ideal_drive_power``, ``drive_power`` W), for a time plot.
+    """
     from crankmodal.dynamics.run.ensemble import EPS
     from crankmodal.dynamics.run.simulate import simulate
 
@@ -192,12 +196,16 @@ def run_case(sc, n_traj: int, log=print) -> dict:
     res = {"ideal": trajectory_numbers(ideal, p, rev_hz), "speed_rpm": 60.0 * rev_hz,
            "end_time_s": t_end, "joints": [c.name for c in mech.system.clearances],
            "gravity": list(p["gravity"]), "trajectories": []}
+    keep = {"t": ideal.t, "ideal_drive_power": ideal.drive_power}
     del ideal
     for k in range(n_traj if mech.system.clearances else 0):
         m = replace(mech, q0=np.asarray(mech.q0, float) * (1.0 + k * EPS))
         h = simulate(m, t_end, dt, settings, energy_tolerance=tol)
         row = trajectory_numbers(h, p, rev_hz)
         res["trajectories"].append(row)
+        if k == 0 and histories is not None:
+            histories.parent.mkdir(parents=True, exist_ok=True)
+            np.savez_compressed(histories, drive_power=h.drive_power, **keep)
         log(f"  trajectory {k}: {row['impacts']} impacts, power mean "
             f"{row['power']['mean']['mean']:.0f} W, half range "
             f"{row['power']['half_range']['mean']:.0f} W (filtered "
@@ -223,7 +231,9 @@ def fig23(n_traj: int, end_time: float, out: Path, cases=None) -> dict:
         if cases and name not in cases:
             continue
         print(f"fig23 {name}", flush=True)
-        results[name] = run_case(scene(("big_end_1",), end_time=end_time, **kw), n_traj)
+        slug = name.replace(" ", "_")
+        results[name] = run_case(scene(("big_end_1",), end_time=end_time, **kw), n_traj,
+                                 histories=out / f"fig23_{slug}.npz")
         _save(out / "fig23.json", results)
     return results
 
@@ -264,7 +274,28 @@ def plot(out: Path) -> None:
         d = json.loads(f23.read_text())
         keys = ("half_range", "half_range_filtered", "rms_fluctuation", "order_4")
         labels = ("(max−min)/2", "(max−min)/2, orders ≤ 12", "RMS of fluctuation", "order 4")
-        fig, axes = plt.subplots(1, len(d), figsize=(4.6 * len(d), 4.2), squeeze=False)
+        hist = out / "fig23_gas.npz"
+        ncol = len(d) + (1 if hist.is_file() else 0)
+        fig, axes = plt.subplots(1, ncol, figsize=(4.6 * ncol, 4.2), squeeze=False)
+        if hist.is_file():
+            z = np.load(hist)
+            ax = axes[0][-1]
+            ax.plot(z["t"], z["drive_power"] / 1e3, lw=0.5, color="C3",
+                    label="0.1 mm big end 1 (trajectory 0)")
+            t, pw = z["t"], z["drive_power"]
+            fs = 1.0 / (t[1] - t[0])
+            X = np.fft.rfft(pw)
+            X[np.fft.rfftfreq(pw.size, 1.0 / fs) > FILTER_ORDERS * 1480.0 / 60.0] = 0.0
+            ax.plot(t, np.fft.irfft(X, pw.size) / 1e3, color="C0", lw=1.0,
+                    label="the same, orders <= 12 (296 Hz)")
+            ax.plot(t, z["ideal_drive_power"] / 1e3, "k--", lw=0.9, label="ideal joints")
+            lim = 3.0 * float(np.max(np.abs(z["ideal_drive_power"][z["t"] > 0.15]))) / 1e3
+            ax.set_ylim(-lim, lim)
+            ax.set_xlabel("time, s")
+            ax.set_ylabel("drive power, kW (impact spikes clipped)")
+            ax.set_title("gas: the time history (the seed's Fig. 23)", fontsize=9)
+            ax.legend(fontsize=7, loc="lower right")
+            ax.grid(alpha=0.3)
         for ax, (name, r) in zip(axes[0], d.items()):
             x = np.arange(len(keys))
             iv = [r["ideal"]["power"][k]["mean"] for k in keys]
