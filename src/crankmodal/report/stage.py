@@ -7,7 +7,9 @@ With ``[geometry]``, ``[material]`` and ``[modal]`` it adds the modal content (i
 the Material and the :class:`~crankmodal.fem.modal.Modes` from ``ctx.products``); a ``[static]``
 section adds a von Mises render. Writes ``report.html`` (self-contained), ``report.md``,
 ``mode_NN.png``, ``mode_sheet.png`` (+ ``mode_NN.gif`` when ``gif``), ``participation.png/.csv``
-(supported parts), ``mac.png/.csv`` (with ``reference``), ``von_mises.png``; with ``study = true`` also the
+(supported parts), ``mac.png/.csv`` (with ``reference``), ``von_mises.png``; after a multi-throw
+``[dynamics]`` run ``dynamics_journal_shares.png`` and ``dynamics_torsion_orders.png``
+(:mod:`crankmodal.dynamics.results.report`, listed as ``train_figures``); with ``study = true`` also the
 simplification study's files (see :mod:`crankmodal.report.study_scene`).
 """
 
@@ -135,6 +137,12 @@ def run(p: dict, ctx) -> dict:
         if section == "static" and vm is not None:
             images.append((vm, "von Mises stress on the deformed shape"))
         stage_section(rep, section, res, out_dir, images=images)
+        if section == "dynamics":  # a multi-throw train: journal shares, torsion, fatigue
+            from ..dynamics.results.report import train_section
+
+            drawn = train_section(rep, res, out_dir, results.get("fatigue"), ctx.figures)
+            if drawn:
+                out["train_figures"] = [relative_name(f, out_dir) for f in drawn]
     if p["study"]:
         _study(p, ctx, rep, out, modal["measured"] if modal else None)
     timings = {f"[{s}]": r["wall_time_s"] for s, r in results.items() if "wall_time_s" in r}
