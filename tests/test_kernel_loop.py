@@ -291,3 +291,17 @@ def test_output_times_outside_the_run_give_the_start_only():
         r = integrate(m.system, m.q0, m.qd0, 0.002, np.array([0.0, 0.01]), s, compiled_loop=loop)
         np.testing.assert_array_equal(r.t, [0.0])
         assert r.y.shape == (2 * m.system.n + 6, 1)
+
+
+def test_an_absurd_contact_stiffness_stops_both_paths_with_the_budget_message():
+    # a journal started inside the wall of a 1e300 N/m^1.5 contact: the initial step is 0 and
+    # the step control works on inf/nan (NumPy's arithmetic, as SciPy: once a
+    # ZeroDivisionError out of the compiled loop); both paths stop at the budget
+    texts = []
+    for loop in (True, False):
+        sysm = _free_journal("hertz", {"stiffness": 1e300, "exponent": 1.5})
+        with pytest.raises(NumericalError) as exc:
+            integrate(sysm, np.array([2e-4, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]), 1e-3, None,
+                      SolverSettings(method="RK45", max_rhs_evals=3000), compiled_loop=loop)
+        texts.append(str(exc.value))
+    assert all("after 3000 right-hand-side evaluations" in t for t in texts), texts

@@ -91,12 +91,12 @@ class Singular(np.linalg.LinAlgError):
 
 
 # ------------------------------------------------------------------------------ compiled part
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rms(x):
     return np.sqrt(np.sum(x * x) / x.size)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _cholesky_solve(sz, L, b, x):
     """``x = B^-1 b`` for a symmetric positive definite ``B = L L^T`` (``L`` lower, ``sz``)."""
     for i in range(sz):
@@ -111,7 +111,7 @@ def _cholesky_solve(sz, L, b, x):
         x[i] = v / L[i, i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def block_solve(A, rhs, n, B):
     """Solve :func:`.compiled.assemble`'s whole KKT system ``A x = rhs`` (``[M Cq^T; Cq 0]``,
     flexible bodies without an oil film) by its block-diagonal mass matrix, in place in ``rhs``
@@ -195,7 +195,7 @@ def block_solve(A, rhs, n, B):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _fun(t, y, dy, M, fs, ns):
     """One counted right-hand side into ``dy``: _OK, or BUDGET / NONFINITE / SINGULAR with the
     time in ``fs[_TFAIL]`` (the budget judged before the evaluation, as Multibody.rhs).
@@ -232,7 +232,7 @@ def _fun(t, y, dy, M, fs, ns):
     return NONFINITE if status == 1 else SINGULAR
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _event_values(y, M, ev, out, g):
     """Every event's function at state ``y``: the penetration (onset, separation) or its rate
     (deepest penetration) of its joint (:func:`.compiled.clearance_kinematics`)."""
@@ -249,7 +249,7 @@ def _event_values(y, M, ev, out, g):
         g[e] = out[6] if ev_kind[e] == PEAK else out[5]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _dense(x_t, t_old, h, y_old, Qd, out):
     """SciPy's RK dense output at ``x_t`` s: ``y_old + h Q [x, x^2, x^3, x^4]``."""
     x = (x_t - t_old) / h
@@ -261,7 +261,7 @@ def _dense(x_t, t_old, h, y_old, Qd, out):
         out[i] = h * (Qd[i, 0] * p0 + Qd[i, 1] * p1 + Qd[i, 2] * p2 + Qd[i, 3] * p3) + y_old[i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _event_at(e, x_t, fs, h, V, Qd, M, ev, out):
     ytmp = V[5]
     _dense(x_t, fs[_TOLD], h, V[2], Qd, ytmp)
@@ -272,7 +272,7 @@ def _event_at(e, x_t, fs, h, V, Qd, M, ev, out):
     return out[6] if ev[1][e] == PEAK else out[5]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _brent(e, xa, xb, fs, h, V, Qd, M, ev, out):
     """Root of event ``e`` on the dense output in [xa, xb]: SciPy's brentq (zeros.c), xtol =
     rtol = 4 eps. Without a sign change (round-off at the bracket's end) the end ``xb``."""
@@ -320,7 +320,7 @@ def _brent(e, xa, xb, fs, h, V, Qd, M, ev, out):
     return xcur
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def start(fs, ns, V, K, atol, M, ev, out, ctl):
     """A segment's start at ``(fs[_T], V[0])``: ``f``, SciPy's initial step, the events."""
     y, f, ytmp = V[0], V[1], V[5]
@@ -350,7 +350,7 @@ def start(fs, ns, V, K, atol, M, ev, out, ctl):
     return _OK
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _step(fs, ns, V, K, atol, M, tab, ctl):
     """One accepted step of SciPy's ``RungeKutta._step_impl`` (RK45): _OK or a failure."""
     C, A, B, E, _P = tab
@@ -423,7 +423,7 @@ def _step(fs, ns, V, K, atol, M, tab, ctl):
     return _OK
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _dense_coefficients(K, P, Qd):
     """``Q = K^T P`` of SciPy's ``RkDenseOutput``."""
     for i in range(Qd.shape[0]):
@@ -434,7 +434,7 @@ def _dense_coefficients(K, P, Qd):
             Qd[i, c] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _after_step(fs, ns, V, K, Qd, M, tab, ev, out, io_bufs):
     """Events and output of the step just taken (``solve_ivp``'s loop body): active events
     located, recorded and, if one is terminal, the step cut there; output samples by the dense
@@ -505,7 +505,7 @@ def _after_step(fs, ns, V, K, Qd, M, tab, ev, out, io_bufs):
     return terminal
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def advance(fs, ns, V, K, Qd, atol, M, tab, ctl, ev, out, io_bufs):
     """Steps until the run ends (DONE), a window ends (WINDOW: ``fs[_TWIN]`` s or
     ``ns[_NWIN]`` evaluations), a terminal event (TERMINAL), a record buffer is full (FULL) or
