@@ -115,7 +115,7 @@ def interface_rigid_fit(body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return s_bar, T, W / float(np.sum(r ** 2))
 
 
-def elastic_deflection(body, modal, t=None, chunk: int = 64) -> dict | None:
+def elastic_deflection(body, modal, t=None, chunk: int = 256) -> dict | None:
     """Largest in-plane elastic deflection of a flexible body over a run, m.
 
     With the mode shapes at the mesh nodes (a file with its mesh) and two interfaces or more,
@@ -132,6 +132,8 @@ def elastic_deflection(body, modal, t=None, chunk: int = 64) -> dict | None:
         Modal coordinates over the run (m kg^½).
     t : (K,) array, optional
         s, for ``time_s``.
+    chunk : int
+        Mesh nodes superposed at once (:func:`.peak_stress.peak_seminorm`).
 
     Returns
     -------
@@ -167,17 +169,10 @@ def elastic_deflection(body, modal, t=None, chunk: int = 64) -> dict | None:
             where = "mesh nodes, relative to the interfaces"
         else:
             where = "mesh nodes, mean axes"
-        best_p = np.zeros(B.shape[0])
-        when_p = np.zeros(B.shape[0], int)
-        for k0 in range(0, len(xi), chunk):
-            u = np.einsum("pik,tk->tpi", B, xi[k0:k0 + chunk])
-            a = np.hypot(u[..., 0], u[..., 1])
-            i = np.argmax(a, axis=0)
-            v = a[i, np.arange(a.shape[1])]
-            better = v > best_p
-            best_p[better], when_p[better] = v[better], k0 + i[better]
-        j = int(np.argmax(best_p))
-        best, when, loc = float(best_p[j]), int(when_p[j]), np.asarray(pts)[j].tolist()
+        from .peak_stress import peak_seminorm  # bounds skip the nodes that cannot lead
+
+        best, j, when, _ = peak_seminorm(B, xi, lambda u: np.hypot(u[:, 0], u[:, 1]), chunk)
+        loc = np.asarray(pts)[j].tolist()
     return {"max_m": best, "where": where, "location_m": loc,
             "time_s": None if t is None else float(t[when])}
 
