@@ -305,3 +305,13 @@ def test_an_absurd_contact_stiffness_stops_both_paths_with_the_budget_message():
                       SolverSettings(method="RK45", max_rhs_evals=3000), compiled_loop=loop)
         texts.append(str(exc.value))
     assert all("after 3000 right-hand-side evaluations" in t for t in texts), texts
+
+
+def test_output_times_out_of_order_are_refused_naming_t_out():
+    from crankmodal.errors import ParameterError
+
+    m = _slider_crank()
+    for loop in (True, False):  # solve_ivp raised a bare ValueError; the loop sampled wrongly
+        with pytest.raises(ParameterError, match="t_out"):
+            integrate(m.system, m.q0, m.qd0, 0.002, np.array([0.0, 0.002, 0.001]),
+                      SolverSettings(method="RK45"), compiled_loop=loop)

@@ -317,7 +317,7 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings,
     ------
     ParameterError
         Naming ``sysm``, ``q0``, ``qd0`` (not ``sysm.n`` finite numbers), ``t_end``, ``t_out``
-        (negative) or ``settings``.
+        (negative, or not strictly increasing) or ``settings``.
     NumericalError
         If the budget of right-hand-side evaluations is exceeded, the solver fails, or a
         non-finite value appears; the message names the stiff parameter.
@@ -333,6 +333,10 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings,
     t_end = arg.number("t_end", t_end, gt=0.0)
     if t_out is not None:
         t_out = np.asarray(arg.numbers("t_out", np.ravel(t_out), ge=0.0), float)
+        if np.any(np.diff(t_out) <= 0.0):  # both paths sample the steps in order
+            from ...errors import ParameterError
+
+            raise ParameterError("t_out", "must be strictly increasing times, s")
     if settings.method == "auto":  # simulate() decides it at the mechanism's speed already
         from dataclasses import replace
 
