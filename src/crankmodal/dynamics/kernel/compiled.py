@@ -41,7 +41,6 @@ from ..model.joints import AngleDrive, Prismatic, Revolute, SpeedProfile, frames
 from ..model.loads import CrankTorque, PistonLoads, TorsionalCoupling
 
 
-
 def _lapack_symbol(name: str) -> str:
     """Register LAPACK's ``name`` (SciPy's ``cython_lapack``) with LLVM under a fixed symbol and
     return it: compiled code calls it by that symbol, resolved when the code is loaded, so the
