@@ -315,3 +315,40 @@ def test_output_times_out_of_order_are_refused_naming_t_out():
         with pytest.raises(ParameterError, match="t_out"):
             integrate(m.system, m.q0, m.qd0, 0.002, np.array([0.0, 0.002, 0.001]),
                       SolverSettings(method="RK45"), compiled_loop=loop)
+
+
+@pytest.mark.slow
+def test_four_star_scene_per_revolution_statistics_within_the_ensemble_spread(monkeypatch):
+    # the seed-000 four-star (scenes/four_star_dynamics.toml, 0.1 mm at big end 1, 1480 rpm),
+    # 0.4 s, three starts 1e-12 apart on each path: the per-revolution main-bearing peak and
+    # the impacts per revolution after the 0.1 s ramp + 1 revolution agree within three
+    # times the larger ensemble spread (chaotic: the paths' trajectories part after a few
+    # impacts, as two starts 1e-12 apart do)
+    from functools import partial
+    from pathlib import Path
+
+    from crankmodal.dynamics.results.stats import statistics
+    from crankmodal.dynamics.run import simulate as sim_mod
+    from crankmodal.dynamics.scene.build import build_mechanism, solver_settings
+    from crankmodal.runner import check
+    from crankmodal.scene import load_scene
+
+    scene = Path(__file__).resolve().parent.parent / "scenes" / "four_star_dynamics.toml"
+    params = check(load_scene(scene, ["dynamics.end_time=0.4"]))
+    p = params["dynamics"]
+    rows = {}
+    for loop in (True, False):
+        monkeypatch.setattr(sim_mod, "integrate", partial(integrate, compiled_loop=loop))
+        for k in range(3):
+            mech = build_mechanism(p, params["mechanism"])
+            mech.q0 = mech.q0 * (1.0 + k * 1e-12)
+            rev = mech.revolution_hz
+            h = sim_mod.simulate(mech, 0.4, 1.0 / (360 * rev), solver_settings(p, 60 * rev))
+            st = statistics(h, rev, p["ramp_time"] + 1.0 / rev)
+            impacts = st["clearance_joints"]["big_end_1"]["impact_velocity"]["count_per_rev"]
+            rows.setdefault(loop, []).append(
+                (st["main_bearing_force"]["per_rev_peak"]["mean"], impacts["mean"]))
+    a, b = np.array(rows[True]), np.array(rows[False])
+    for col in range(2):
+        spread = max(a[:, col].std(ddof=1), b[:, col].std(ddof=1), 0.02 * b[:, col].mean())
+        assert abs(a[:, col].mean() - b[:, col].mean()) <= 3.0 * spread, (a, b)
