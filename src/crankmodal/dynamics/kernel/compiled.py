@@ -977,8 +977,11 @@ def flush_if_changed(namespace: dict, name: str, modules) -> bool:
 
     digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes()
                                      for m in modules)).hexdigest()
+    # only the module's own functions: its namespace also holds the ones it imports, whose
+    # caches belong to their modules (flushing them made the next process compile them again)
     cached = [f for f in namespace.values()
-              if getattr(f, "_cache", None) is not None and hasattr(f, "py_func")]
+              if getattr(f, "_cache", None) is not None
+              and getattr(getattr(f, "py_func", None), "__module__", None) == name]
     try:
         stamp = Path(cached[0]._cache._cache_path) / f"{name.rsplit('.', 1)[-1]}.deps"
     except (IndexError, AttributeError):  # no cached function, or numba's internals moved

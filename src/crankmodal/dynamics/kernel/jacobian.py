@@ -269,11 +269,7 @@ def _flush_if_dependencies_changed() -> bool:
     from ..model import clearance, joints
     from . import compiled
 
-    # only this module's functions: the namespace also holds the kernel's (imported), whose
-    # cache is the kernel's to keep (flushing it here made the next process compile it again)
-    own = {k: f for k, f in globals().items()
-           if getattr(getattr(f, "py_func", None), "__module__", None) == __name__}
-    return flush_if_changed(own, __name__,
+    return flush_if_changed(globals(), __name__,
                             (compiled, clearance, lubrication, reynolds, joints))
 
 
