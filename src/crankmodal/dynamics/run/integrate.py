@@ -420,7 +420,10 @@ def integrate(sysm, q0, qd0, t_end, t_out, settings: SolverSettings,
             raise _failure(exc, sysm, settings, t) from None
         if sol.status == -1:
             pbar.close()
-            raise NumericalError(f"integrator failed at t = {sol.t[-1]:.6g} s ({sol.message}); "
+            # with t_eval, sol.t holds only the output times reached: none when it failed
+            # before the first one, so the failure time is that of the restart point then
+            t_fail = sol.t[-1] if len(sol.t) else t
+            raise NumericalError(f"integrator failed at t = {t_fail:.6g} s ({sol.message}); "
                                  f"{_stiffness_advice(sysm, settings)}")
         st = np.asarray(sol.t, float)
         sy = np.asarray(sol.y, float).reshape(y.size, -1)
