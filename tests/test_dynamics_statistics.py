@@ -316,3 +316,28 @@ def test_headline_takes_the_ensemble_spread_only_where_trajectories_disagree_bey
     h = headline_value([7.0], [0.5])
     assert (h["value"], h["uncertainty"], h["n_trajectories"]) == (7.0, 0.5, 1)
 
+
+
+def test_a_four_stroke_knock_alternating_by_revolution_is_steady_per_cycle():
+    # knock of 1 m/s in every firing revolution, 0.1 m/s in the other: per revolution the
+    # alternation reads as scatter (standard error 0.45/sqrt(n) of the mean 0.55), per
+    # working cycle of two revolutions the knock is exactly 1 m/s, no scatter (closed form)
+    from crankmodal.dynamics.results.stats import impact_velocity_statistics, signal_statistics
+
+    hz, n = 25.0, 12
+    onsets = [((k + 0.3) / hz, 1.0 if k % 2 == 0 else 0.1) for k in range(n)]
+    st = impact_velocity_statistics(onsets, 0.0, hz, n, revolutions_per_cycle=2)
+    assert st["max_per_rev"]["mean"] == pytest.approx(0.55, rel=1e-12)
+    assert st["max_per_rev"]["sem"] > 0.1
+    assert st["max_per_cycle"]["mean"] == pytest.approx(1.0, rel=1e-12)
+    assert st["max_per_cycle"]["sem"] == 0.0 and st["max_per_cycle"]["n"] == n // 2
+    assert st["count_per_cycle"]["mean"] == pytest.approx(2.0, rel=1e-12)
+    # a signal peaking at 3 in firing revolutions and 1 in the others (and a 13th, incomplete
+    # cycle left out)
+    t = np.arange(13 * 100) / (100 * hz)
+    block = np.floor(t * hz + 1e-9).astype(int)
+    x = np.where(block % 2 == 0, 3.0, 1.0) * np.sin(2 * np.pi * hz * t) ** 2
+    sig = signal_statistics(x, block, 13, hz, spectra=False, revolutions_per_cycle=2)
+    assert sig["per_cycle_peak"]["n"] == 6
+    assert sig["per_cycle_peak"]["mean"] == pytest.approx(3.0, rel=1e-12)
+    assert "per_cycle_peak" not in signal_statistics(x, block, 13, hz, spectra=False)

@@ -112,6 +112,17 @@ def summarise(values) -> dict:
             "median": float(np.median(v)), "min": float(v.min()), "max": float(v.max()), "n": n}
 
 
+def per_cycle(values, revolutions_per_cycle: int, how: str = "max") -> np.ndarray:
+    """Per-revolution values grouped into working cycles of ``revolutions_per_cycle``
+    consecutive revolutions (a four-stroke engine: 2), each cycle's ``max`` or ``sum``; a
+    trailing incomplete cycle is left out."""
+    v = np.asarray(values, float)
+    k = int(revolutions_per_cycle)
+    m = v.size // k
+    blocks = v[: m * k].reshape(m, k)
+    return blocks.max(axis=1) if how == "max" else blocks.sum(axis=1)
+
+
 def per_revolution_peaks(x, block, n, event_block=(), event_x=()) -> np.ndarray:
     """Largest ``|x|`` in each revolution, samples and events (e.g. a contact's deepest point).
 
@@ -174,7 +185,7 @@ def per_revolution_spectra(x, block, n, revolution_hz, orders=ORDERS, edges=BAND
 
 
 def signal_statistics(x, block, n, revolution_hz, event_block=(), event_x=(),
-                      spectra=True) -> dict:
+                      spectra=True, revolutions_per_cycle: int = 1) -> dict:
     """Per-revolution peak, RMS and (``spectra``) order amplitudes and band levels of a signal.
 
     Returns
@@ -182,10 +193,14 @@ def signal_statistics(x, block, n, revolution_hz, event_block=(), event_x=(),
     dict
         ``per_rev_peak`` and ``rms`` (:func:`summarise` of the per-revolution values), and with
         ``spectra`` ``order_amplitude`` (``orders``, ``mean``, ``sem`` lists) and ``band_rms``
-        (``edges_hz``, ``mean``, ``sem``), all in the unit of ``x``.
+        (``edges_hz``, ``mean``, ``sem``), all in the unit of ``x``; with
+        ``revolutions_per_cycle`` > 1 (a four-stroke engine) also ``per_cycle_peak``, the
+        summary of each working cycle's largest ``|x|``.
     """
-    out = {"per_rev_peak": summarise(per_revolution_peaks(x, block, n, event_block, event_x)),
-           "rms": summarise(per_revolution_rms(x, block, n))}
+    peaks = per_revolution_peaks(x, block, n, event_block, event_x)
+    out = {"per_rev_peak": summarise(peaks), "rms": summarise(per_revolution_rms(x, block, n))}
+    if revolutions_per_cycle > 1:
+        out["per_cycle_peak"] = summarise(per_cycle(peaks, revolutions_per_cycle))
     if spectra:
         amps, bands = per_revolution_spectra(x, block, n, revolution_hz)
         out["order_amplitude"] = _columns(amps, {"orders": list(ORDERS)})
@@ -201,7 +216,8 @@ def _columns(a, head: dict) -> dict:
     return head
 
 
-def impact_velocity_statistics(onsets, t_start, revolution_hz, n, v_min=0.0, seed=0) -> dict:
+def impact_velocity_statistics(onsets, t_start, revolution_hz, n, v_min=0.0, seed=0,
+                               revolutions_per_cycle: int = 1) -> dict:
     """Impact-velocity distribution of one clearance joint over ``n`` revolutions from
     ``t_start``.
 
@@ -213,7 +229,10 @@ def impact_velocity_statistics(onsets, t_start, revolution_hz, n, v_min=0.0, see
     -------
     dict
         ``p50``, ``p90``, ``max`` (m/s) with ``p50_sem``, ``p90_sem``; ``count_per_rev`` and
-        ``max_per_rev`` (:func:`summarise` of the per-revolution count and largest velocity).
+        ``max_per_rev`` (:func:`summarise` of the per-revolution count and largest velocity);
+        with ``revolutions_per_cycle`` > 1 also ``count_per_cycle`` and ``max_per_cycle`` (per
+        working cycle: a four-stroke engine knocks in its firing revolution and rests in the
+        other, an alternation the per-revolution standard error counts as scatter).
     """
     ons = np.asarray(onsets, float).reshape(-1, 2)
     b = np.floor((ons[:, 0] - t_start) * revolution_hz + 1e-9).astype(int)
@@ -238,10 +257,14 @@ def impact_velocity_statistics(onsets, t_start, revolution_hz, n, v_min=0.0, see
             out["p50_sem"], out["p90_sem"] = (float(s) for s in qs.std(axis=0, ddof=1))
     out["count_per_rev"] = summarise(counts)
     out["max_per_rev"] = summarise(vmax)
+    if revolutions_per_cycle > 1:
+        out["count_per_cycle"] = summarise(per_cycle(counts, revolutions_per_cycle, "sum"))
+        out["max_per_cycle"] = summarise(per_cycle(vmax, revolutions_per_cycle))
     return out
 
 
-def statistics(hist, revolution_hz: float, t_start: float, v_min: dict | None = None) -> dict:
+def statistics(hist, revolution_hz: float, t_start: float, v_min: dict | None = None,
+               revolutions_per_cycle: int = 1) -> dict:
     """The ``statistics`` block of a run's results.
 
     Parameters
@@ -253,6 +276,10 @@ def statistics(hist, revolution_hz: float, t_start: float, v_min: dict | None = 
         s, start of the first whole revolution counted (after the start-up).
     v_min : dict, optional
         Joint name -> impact velocity floor, m/s (onsets below it are grazing, not impacts).
+    revolutions_per_cycle : int
+        Revolutions of one working cycle (2 for a four-stroke engine): adds the per-cycle
+        statistics (``per_cycle_peak``, ``count_per_cycle``, ``max_per_cycle``) and the
+        window's ``revolutions_per_cycle`` and ``n_cycles``.
 
     Returns
     -------
@@ -271,7 +298,9 @@ def statistics(hist, revolution_hz: float, t_start: float, v_min: dict | None = 
     mag = np.hypot(f[:, 0], f[:, 1])
     ev_f = np.concatenate([pk["main_bearing_force"] for pk in hist.peaks.values()]
                           or [np.zeros(0)])
-    main = signal_statistics(mag, block, n, revolution_hz, ev_b, ev_f, spectra=False)
+    rpc = int(revolutions_per_cycle)
+    main = signal_statistics(mag, block, n, revolution_hz, ev_b, ev_f, spectra=False,
+                             revolutions_per_cycle=rpc)
     for c, name in enumerate(("x", "y")):
         s = signal_statistics(f[:, c], block, n, revolution_hz)
         main[f"order_amplitude_{name}"] = s["order_amplitude"]
@@ -281,19 +310,23 @@ def statistics(hist, revolution_hz: float, t_start: float, v_min: dict | None = 
         ev_a = np.concatenate([pk["piston_acceleration"][:, i] for pk in hist.peaks.values()]
                               or [np.zeros(0)])
         pistons.append(signal_statistics(hist.piston_acceleration[:, i], block, n,
-                                         revolution_hz, ev_b, ev_a))
+                                         revolution_hz, ev_b, ev_a, revolutions_per_cycle=rpc))
     joints = {}
     for name, d in hist.contact.items():
         pk = hist.peaks.get(name, {"t": np.zeros(0), "fn": np.zeros(0)})
         joints[name] = {
             "contact_force": signal_statistics(
                 d["fn"], block, n, revolution_hz, block_of(pk["t"], t_start, revolution_hz, n),
-                pk["fn"], spectra=False),
+                pk["fn"], spectra=False, revolutions_per_cycle=rpc),
             "impact_velocity": impact_velocity_statistics(hist.onsets.get(name, []), t_start,
-                                                          revolution_hz, n, v_min.get(name, 0.0)),
+                                                          revolution_hz, n, v_min.get(name, 0.0),
+                                                          revolutions_per_cycle=rpc),
         }
-    return {"window": {"start_s": float(t_start), "end_s": float(t_start + n / revolution_hz),
-                       "n_revolutions": n},
+    window = {"start_s": float(t_start), "end_s": float(t_start + n / revolution_hz),
+              "n_revolutions": n}
+    if rpc > 1:
+        window.update(revolutions_per_cycle=rpc, n_cycles=n // rpc)
+    return {"window": window,
             "main_bearing_force": main, "piston_acceleration": pistons,
             "clearance_joints": joints}
 

@@ -353,6 +353,16 @@ def _joint_results(model: _Model, runs: _Runs, sel, p: dict) -> dict:
     return joints
 
 
+def _revolutions_per_cycle(mech) -> int:
+    """Revolutions of the machine's working cycle: its gas tables' period (a four-stroke
+    engine's 720 degrees: 2), 1 without a tabulated gas force."""
+    from ..model.loads import PistonLoads
+
+    periods = [ld.gas_force.table[2] for ld in mech.system.loads
+               if type(ld) is PistonLoads and getattr(ld.gas_force, "table", None) is not None]
+    return max([int(round(per / (2.0 * np.pi))) for per in periods] or [1])
+
+
 def _statistics(res: dict, model: _Model, runs: _Runs, sel, p: dict) -> None:
     """Per-revolution statistics (what converges: a single trajectory's peak does not), the
     ensemble's spread, the headline numbers and the ideal twin's, into ``res``."""
@@ -362,7 +372,7 @@ def _statistics(res: dict, model: _Model, runs: _Runs, sel, p: dict) -> None:
     hist, rev_hz = runs.hist, model.rev_hz
     t0 = float(hist.t[sel][0])
     v_min = {cj.name: cj.v_impact_min for cj in model.mech.system.clearances}
-    res["statistics"] = statistics(hist, rev_hz, t0, v_min)
+    res["statistics"] = statistics(hist, rev_hz, t0, v_min, _revolutions_per_cycle(model.mech))
     if p["ensemble"] > 1:
         res["ensemble"] = run_ensemble(model.mech, res["statistics"], p["ensemble"], model.t_end,
                                        model.dt, model.settings, rev_hz, t0, v_min,
