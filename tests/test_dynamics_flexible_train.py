@@ -303,4 +303,5 @@ def test_quasi_static_start_removes_the_start_up_ringing(parts):
     f0, f1 = np.hypot(*h0.main_bearing_force.T), np.hypot(*h1.main_bearing_force.T)
     assert f0.max() > 10 * f1.max()
     assert f1.max() < 3 * np.median(f1)
-    assert h1.nfev < 0.5 * h0.nfev
+    # 476 of 950 evaluations since the crank's modes count their axial kinetic energy (crank_body)
+    assert h1.nfev < 0.55 * h0.nfev
