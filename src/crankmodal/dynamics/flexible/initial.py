@@ -149,7 +149,8 @@ def quasi_static_start(sysm, q, qd, t=0.0, tol=1e-9, max_iter=10):
             f"dynamics: the quasi-static start did not close the joints at t = {t} s (residual "
             f"{np.max(np.abs(F[:m])):.1e} after {it} Newton steps); start the flexible bodies "
             f"undeformed or check the assembly")
-    q, qd = sysm.assemble(t, q, qd, hold=cols, rcond=RCOND)  # the last 1e-12 of the joints; the velocities
+    # the joints' last 1e-12 with the modes held, and the velocities
+    q, qd = sysm.assemble(t, q, qd, hold=cols, rcond=RCOND)
     r = float(np.max(np.abs(residual(q)[0][m:])))
     if r >= tol:
         import warnings
