@@ -54,14 +54,19 @@ def torsion_histories(mech, sysm, integ) -> dict:
         out["coupling_twist"] = tw
         out["coupling_torque"] = tq
     crank = mech.crank
-    if crank.ndof > 3 and id(crank) in sysm.slices:
+    drive = getattr(mech, "drive_frame", None) or mech.main_joint
+    frames = getattr(crank, "frames", {})
+    # a flexible crank of a crank train (a free flexible body has no drive frame to twist from)
+    if crank.ndof > 3 and id(crank) in sysm.slices and drive in frames:
         sl = sysm.slices[id(crank)]
         xi = integ.y[sl.start + 3: sl.stop]
-        drive = getattr(mech, "drive_frame", None) or mech.main_joint
-        rz0 = crank.frames[drive][2]
+        rz0 = frames[drive][2]
         for frame in _crank_frames(mech):
-            out[f"twist_{frame}"] = (crank.frames[frame][2] - rz0) @ xi
-        out["twist_free_end"] = out[f"twist_{free_end_frame(mech)}"].copy()
+            if frame in frames:
+                out[f"twist_{frame}"] = (frames[frame][2] - rz0) @ xi
+        end = free_end_frame(mech)
+        if f"twist_{end}" in out:
+            out["twist_free_end"] = out[f"twist_{end}"].copy()
     return out
 
 
