@@ -217,3 +217,18 @@ def test_loom_film_statistics_within_the_ensemble_spread_of_the_former_jacobian(
     for key, s in ens["spread"].items():
         sem = np.sqrt(np.mean([r[key] ** 2 for r in ens["per_trajectory_sem"] if key in r]))
         assert abs(former[key] - s["mean"]) <= 3.0 * max(s["std"], sem), key
+
+
+def test_difference_step_floor_stays_at_the_film_scale_at_tight_tolerances():
+    # the floor atol/rtol grew with a tight rtol: at rtol 1e-9 a 1.5 um step on a 50 um film;
+    # capped at the default rtol's scale it stays 1.5 nm (positions, atol 1e-9 m)
+    from crankmodal.dynamics.kernel import jacobian as jm
+
+    class K:  # what CompiledJacobian reads of the kernel at construction
+        n, gas_py = 2, np.zeros(0)
+
+    atol = np.array([1e-9, 1e-9, 1e-6, 1e-6])
+    tight = jm.CompiledJacobian(K, np.zeros(0), atol, 1e-9).floor
+    default = jm.CompiledJacobian(K, np.zeros(0), atol, 1e-6).floor
+    np.testing.assert_array_equal(tight, default)
+    assert jm._SQRT_EPS * tight[0] < 2e-9
