@@ -38,6 +38,36 @@ class InputFileError(CrankmodalError):
     """
 
 
+class FileMemberError(InputFileError):
+    """A saved file (flexbody, dynamics or fatigue result, ...) that cannot be trusted:
+    unreadable, of another format, or a member of the wrong kind, shape or value. The message
+    names the file and the member.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    member : str
+        The offending member (``""``: the file as a whole).
+    text : str
+        What is wrong with it.
+    exit_code : int
+        2, as :class:`InputFileError`.
+    """
+
+    def __init__(self, path, member: str = "", text: str | None = None):
+        if text is None:  # one argument: a message re-raised under a scene key, as it is
+            self.path, self.member, self.text = "", member, str(path)
+            super().__init__(str(path))
+            return
+        self.path, self.member, self.text = str(path), member, text
+        where = f"{path}: member {member!r}" if member else str(path)
+        super().__init__(f"{where}: {text}")
+
+    def __reduce__(self):  # picklable (a study's worker raises it in another process)
+        return type(self), (self.path, self.member, self.text)
+
+
 class OutputError(CrankmodalError):
     """An output file or folder cannot be written (the folder is a file, read-only, the disk is
     full); the message names the path and the system's reason.

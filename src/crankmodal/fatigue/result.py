@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputFileError
+from ..errors import FileMemberError, InputFileError
 
 FORMAT = "crankmodal-fatigue"
 VERSION = 1
@@ -24,21 +24,13 @@ VERSION = 1
 _PER_POINT = ("safety_factor", "alternating", "mean", "max_von_mises", "proportionality")
 
 
-class FatigueFileError(InputFileError):
+class FatigueFileError(FileMemberError):
     """A saved fatigue result that cannot be trusted; the message names the file and member.
 
     Attributes
     ----------
     path, member, text : str
     """
-
-    def __init__(self, path, member: str = "", text: str = ""):
-        self.path, self.member, self.text = str(path), member, text
-        where = f"{path}: member {member!r}" if member else str(path)
-        super().__init__(f"{where}: {text}")
-
-    def __reduce__(self):
-        return type(self), (self.path, self.member, self.text)
 
 
 @dataclass

@@ -53,7 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputFileError
+from ..errors import FileMemberError, InputFileError
 from ..results import atomic_path
 from .flexbody import FlexibleBody
 
@@ -131,7 +131,7 @@ REQUIRED = ("format", "version", "name", *_ARRAYS, "interface_names", "interface
             *(f"I{i}" for i in range(1, 10)))
 
 
-class FlexbodyFileError(InputFileError):
+class FlexbodyFileError(FileMemberError):
     """A flexbody file that cannot be trusted: unreadable, not a flexbody, or a member of the
     wrong kind, shape or value. The message names the file and the member.
 
@@ -144,18 +144,6 @@ class FlexbodyFileError(InputFileError):
     text : str
         What is wrong with it.
     """
-
-    def __init__(self, path, member: str = "", text: str | None = None):
-        if text is None:  # one argument: a message re-raised under a scene key, as it is
-            self.path, self.member, self.text = "", member, str(path)
-            super().__init__(str(path))
-            return
-        self.path, self.member, self.text = str(path), member, text
-        where = f"{path}: member {member!r}" if member else str(path)
-        super().__init__(f"{where}: {text}")
-
-    def __reduce__(self):  # picklable (a study's worker raises it in another process)
-        return type(self), (self.path, self.member, self.text)
 
 
 class _Members:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import InputFileError
+from ...errors import FileMemberError, InputFileError
 from .history import History
 from .result import FORMAT, PREFIXES, VERSION, DynamicsResult, MachineInfo
 from .signals import Spectrum
@@ -33,21 +33,13 @@ CONTACT_KEYS = ("fn", "ft", "penetration", "penetration_rate", "ex", "ey", "ex_b
 PEAK_KEYS = ("t", "fn", "penetration", "main_bearing_force", "piston_acceleration")
 
 
-class DynamicsFileError(InputFileError):
+class DynamicsFileError(FileMemberError):
     """A saved dynamics result that cannot be trusted; the message names the file and member.
 
     Attributes
     ----------
     path, member, text : str
     """
-
-    def __init__(self, path, member: str = "", text: str = ""):
-        self.path, self.member, self.text = str(path), member, text
-        where = f"{path}: member {member!r}" if member else str(path)
-        super().__init__(f"{where}: {text}")
-
-    def __reduce__(self):
-        return type(self), (self.path, self.member, self.text)
 
 
 class _Members:
