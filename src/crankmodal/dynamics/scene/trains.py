@@ -86,11 +86,19 @@ def machine_cylinders(p, mechanism_params) -> dict:
     ct = p["crank_train"]
     throws = ct.get("cylinder_throws")
     order = ct.get("firing_order")
-    with scene_keys(KEY):
-        return cylinders_from_mechanism(
-            mechanism_params, p["ring_friction_n"],
-            None if throws is None else [t - 1 for t in throws],
-            None if order is None else [c - 1 for c in order])
+    try:
+        with scene_keys(KEY):
+            return cylinders_from_mechanism(
+                mechanism_params, p["ring_friction_n"],
+                None if throws is None else [t - 1 for t in throws],
+                None if order is None else [c - 1 for c in order])
+    except SceneError as exc:
+        if "does not fit in one working cycle" not in str(exc):
+            raise
+        # a permutation that does not fit: the cylinders' angles are the other half (as
+        # [torsion.forced] says it)
+        raise SceneError(f"{exc} -- check the firing order against "
+                         "mechanism.cylinders[i].throw_angle_deg and bank_angle_deg") from None
 
 
 def check_arrangement(p, scene) -> None:
