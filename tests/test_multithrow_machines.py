@@ -191,3 +191,22 @@ def test_inline6_flexible_scene_journal_forces_balance_the_crank_and_differ_from
     shares = np.array([mj[f"main_{j}"]["share_mean"] for j in range(1, 8)])
     assert shares.sum() == pytest.approx(1.0, abs=1e-9)
     assert shares[1:6].sum() >= 0.3  # the lever rule on the end journals gives 0
+
+
+@pytest.mark.slow
+def test_flexible_crank_figures_when_the_whole_cycle_window_ends_before_the_run(tmp_path):
+    """0.2 s at 1800 rpm from 0.0667 s holds 1.99 working cycles: the results window is one
+    cycle (to 0.1667 s) and the run's last revolution lies outside it. The main-bearing figure
+    plots the window's last revolution (it raised IndexError on an empty selection, exit 1
+    with a traceback)."""
+    code = "import sys; from crankmodal.cli import main; sys.exit(main())"
+    out = tmp_path / "out"
+    proc = subprocess.run(
+        [sys.executable, "-c", code, "run", str(SCENES / "inline6_flexible_dynamics.toml"),
+         "--out", str(out), "--set", "dynamics.end_time=0.2",
+         "--set", "dynamics.spectrum_start=0.0666667"],
+        capture_output=True, text=True, timeout=900, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    window = json.loads((out / "results.json").read_text())["dynamics"]["peak_window_s"]
+    assert window[1] < 0.19  # the case: the window ends a revolution before the run
+    assert (out / "dynamics_flexible_main_bearing.png").stat().st_size > 0

@@ -47,7 +47,10 @@ def plot_main_bearing(hist, rigid, machine, sel, path: Path) -> Path:
     series = _force_series(hist, rigid, machine)
     n = 1 + len(series)
     fig, ax = plt.subplots(n, 1, figsize=(9, 2.6 * n))
-    last = last_revolutions(hist, 1.0) & sel
+    # the window's last revolution: a window of whole working cycles may end before the run
+    idx = np.flatnonzero(sel)
+    last = (sel & (np.abs(hist.crank_angle[idx[-1]] - hist.crank_angle) <= 2.0 * np.pi)
+            if idx.size else last_revolutions(hist, 1.0))
     ang = hist.crank_angle[last]  # a coordinate of the run: continuous, no wrap
     deg = np.rad2deg(np.abs(ang - ang[0]))  # turned since the last revolution began
     for a, (label, f, fr) in zip(ax, series):
