@@ -11,7 +11,7 @@ import numpy as np
 COLOUR_SPAN = 4.0
 
 
-def plot_safety(result, path=None):
+def plot_safety(result, path=None, required: float | None = None):
     """Safety factor per location (bars, worst point of each) and the Haigh diagram.
 
     The Haigh diagram plots each location's worst point (equivalent mean, equivalent
@@ -23,6 +23,9 @@ def plot_safety(result, path=None):
     result : FatigueResult
     path : str or Path, optional
         PNG to write (atomically); without it the figure is returned.
+    required : float, optional
+        The required safety factor: a line on the bars, and the mean-stress line divided by it
+        (dashed) on the Haigh diagram.
 
     Returns
     -------
@@ -42,6 +45,9 @@ def plot_safety(result, path=None):
     ax.set_yticks(range(len(names)), [k.replace("_", " ") for k in names], fontsize=8)
     ax.invert_yaxis()
     ax.axvline(1.0, color="black", lw=1)
+    if required is not None:
+        ax.axvline(required, color="#c0392b", lw=1, ls="--", label=f"required {required:.3g}")
+        ax.legend(fontsize=8, loc="lower right")
     for i, v in enumerate(n):
         ax.text(v if np.isfinite(v) else 0.0, i, f" {v:.3g}", va="center", fontsize=8)
     worst = result.worst_location
@@ -54,6 +60,9 @@ def plot_safety(result, path=None):
     hx.plot(m, line, color="black", lw=1.5, label=f"{result.rule} line (S_e = {se:.4g} MPa)")
     hx.plot([-su, 0.0], [se, se], color="black", lw=1.5, ls="--",
             label="compressive mean: no credit")
+    if required is not None:
+        hx.plot(m, line / required, color="#c0392b", lw=1.0, ls="--",
+                label=f"{result.rule} line / required {required:.3g}")
     for k, name in enumerate(names):
         xy = (locs[name]["mean_pa"] / 1e6, locs[name]["alternating_pa"] / 1e6)
         hx.plot(*xy, "o", color=colours[k], ms=5)

@@ -189,12 +189,12 @@ class FatigueResult:
         return _read(Path(path))
 
     # ---- figures ---------------------------------------------------------------------------
-    def plot_safety(self, path=None):
+    def plot_safety(self, path=None, required: float | None = None):
         """Bar chart of the safety factor per location and the Haigh diagram of their worst
         points (see :func:`crankmodal.fatigue.plots.plot_safety`)."""
         from .plots import plot_safety
 
-        return plot_safety(self, path)
+        return plot_safety(self, path, required)
 
     def plot_crank(self, mesh_points, cells, path, title: str | None = None) -> Path:
         """PNG of the part's surface coloured by safety factor, off-screen (see

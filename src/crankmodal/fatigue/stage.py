@@ -423,7 +423,7 @@ def run(p: dict, ctx) -> dict:
     if ens:
         out["ensemble"] = ens
     if ctx.figures:
-        out["figures"] = _figures(res, fb, ctx.out_dir, p["body"])
+        out["figures"] = _figures(res, fb, ctx.out_dir, p["body"], p["required_safety_factor"])
     out["summary"] = summary_line(out)
     res.save(ctx.out_dir / "fatigue.npz")
     ctx.products[SECTION] = res
@@ -442,9 +442,9 @@ def json_safe(obj):
     return obj
 
 
-def _figures(res, fb, out_dir, body: str) -> list[str]:
+def _figures(res, fb, out_dir, body: str, required: float) -> list[str]:
     names = []
-    res.plot_safety(out_dir / "fatigue_haigh.png")
+    res.plot_safety(out_dir / "fatigue_haigh.png", required=required)
     names.append("fatigue_haigh.png")
     if fb.mesh_points is not None and fb.mesh_cells is not None:
         res.plot_crank(fb.mesh_points, fb.mesh_cells, out_dir / "fatigue_crank.png",
