@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import SceneError, scene_keys
+from ...errors import ParameterError, SceneError, scene_keys
 from ..laws import contact
 from ..laws.objects import FrictionLaw, NormalLaw, make_friction, make_law
 from ..model.clearance import ClearanceSpec
@@ -89,6 +89,10 @@ def normal_law(p, clearance: dict) -> NormalLaw:
         params["radial_clearance"] = clearance["clearance"]
     elif params["stiffness"] is None:
         rj = clearance["journal_radius"]
+        if not rj + clearance["clearance"] > rj:  # the bore's radius rounds to the journal's
+            raise ParameterError("clearance", f"{clearance['clearance']:.3g} m is lost in the "
+                                 f"round-off of the journal radius {rj:.3g} m: the bore cannot "
+                                 "be told from the journal")
         params["stiffness"] = float(contact.cylinder_stiffness(
             rj, rj + clearance["clearance"], c["E"], c["nu"], c["E"], c["nu"]))
     with scene_keys("dynamics.contact", NORMAL_LAW_KEYS | {"name": "law"}):
