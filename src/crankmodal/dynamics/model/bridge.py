@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...errors import ParameterError
 from .loads import tabulated_gas_force
 from .mechanisms import Cylinder
 
@@ -68,7 +69,10 @@ def cylinders_from_mechanism(mech_params: dict, ring_friction: float = 0.0,
         order = np.argsort(ang)
         ang, force = ang[order], np.asarray(res.gas_force)[order, i]
         gas = tabulated_gas_force(ang, force, cycle) if m.gas is not None else None
-        out.append(Cylinder.from_machine(m, c, gas_force=gas, ring_friction=ring_friction))
+        try:
+            out.append(Cylinder.from_machine(m, c, gas_force=gas, ring_friction=ring_friction))
+        except ParameterError as exc:  # which cylinder of the machine
+            raise ParameterError(f"cylinders[{i}].{exc.argument}", exc.text) from None
     return {"crank_radius": m.crank_radius, "cylinders": out, "direction": -1,
             "speed_rpm": m.speed_rpm, "crank_unbalance": m.crank_unbalance,
             "arrangement": arrangement}

@@ -11,7 +11,7 @@ forced torsion builds from the same ``[mechanism]`` machine
 
 from __future__ import annotations
 
-from ...errors import SceneError, scene_keys
+from ...errors import ParameterError, SceneError, scene_keys
 from ...schema import Field
 
 KEY = "dynamics.crank_train"
@@ -78,6 +78,23 @@ def train_arguments(p, flexible_crank: bool = False) -> dict:
     return out
 
 
+#: the [mechanism] keys of a crank-train cylinder's fields ("{i}": the cylinder's index)
+MECHANISM_KEYS = {"rod_length": "mechanism.rod_length", "rod_mass": "mechanism.rod_mass",
+                  "rod_inertia": "mechanism.rod_inertia",
+                  "rod_com": "mechanism.rod_cg_from_big_end",
+                  "piston_mass": "mechanism.cylinders[{i}].piston_mass"}
+
+
+def _mechanism_key(argument: str | None) -> str | None:
+    """The ``[mechanism]`` key of a cylinder's argument ``cylinders[i].<field>``, or None."""
+    import re
+
+    m = re.fullmatch(r"cylinders\[(\d+)\]\.(\w+)", argument or "")
+    if m is None or m.group(2) not in MECHANISM_KEYS:
+        return None
+    return MECHANISM_KEYS[m.group(2)].format(i=m.group(1))
+
+
 def machine_cylinders(p, mechanism_params) -> dict:
     """:func:`~..model.bridge.cylinders_from_mechanism` with the keys' throws and firing order
     (1-based in the scene), errors named by their keys."""
@@ -88,10 +105,16 @@ def machine_cylinders(p, mechanism_params) -> dict:
     order = ct.get("firing_order")
     try:
         with scene_keys(KEY):
-            return cylinders_from_mechanism(
-                mechanism_params, p["ring_friction_n"],
-                None if throws is None else [t - 1 for t in throws],
-                None if order is None else [c - 1 for c in order])
+            try:
+                return cylinders_from_mechanism(
+                    mechanism_params, p["ring_friction_n"],
+                    None if throws is None else [t - 1 for t in throws],
+                    None if order is None else [c - 1 for c in order])
+            except ParameterError as exc:  # a cylinder's value comes from [mechanism]
+                key = _mechanism_key(exc.argument)
+                if key is None:
+                    raise
+                raise SceneError(f"{key}: {exc.text}") from None
     except SceneError as exc:
         if "does not fit in one working cycle" not in str(exc):
             raise
