@@ -105,8 +105,7 @@ def plot_crank(result, mesh_points, cells, path, title: str | None = None) -> Pa
     """
     from ..arguments import path as path_argument
     from ..errors import ParameterError
-    from ..report.render import _add_triad, _place_camera, _plotter, boundary_surface, part_camera
-    from ..results import atomic_path
+    from ..report.render import _finish, _plotter, boundary_surface, part_camera
 
     path_argument("path", path)
     pts = np.asarray(mesh_points, float)
@@ -146,10 +145,7 @@ def plot_crank(result, mesh_points, cells, path, title: str | None = None) -> Pa
         pl.add_text(title, position="upper_edge", font_size=13, color="black")
         pl.add_text(f"grey: not assessed; colours clipped at {hi:.3g}", position="lower_left",
                     font_size=9, color="#555555")
-        _add_triad(pl)
-        _place_camera(pl, camera)
-        with atomic_path(path) as tmp:
-            pl.screenshot(str(tmp))
+        _finish(pl, camera, path)
     finally:
         pl.close()
     return Path(path)

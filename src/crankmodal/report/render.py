@@ -137,6 +137,14 @@ def _add_triad(pl):
     pl.add_axes(color="black", line_width=3, labels_off=False, viewport=(0.0, 0.04, 0.17, 0.3))
 
 
+def _finish(pl, camera, path) -> None:
+    """The axis triad, the camera, and the picture written to ``path`` (atomically)."""
+    _add_triad(pl)
+    _place_camera(pl, camera)
+    with atomic_path(path) as tmp:
+        pl.screenshot(str(tmp))
+
+
 def _place_camera(pl, camera):
     pl.camera_position = [camera["position"], camera["focal_point"], camera["view_up"]]
     pl.camera.view_angle = 30.0
@@ -189,10 +197,7 @@ def render_mode(surface: Surface, shape: np.ndarray, path, title: str, camera: d
         pl.add_text(title, position="upper_edge", font_size=14, color="black")
         pl.add_text(f"deformation scaled to {100 * fraction:.0f} % of the part's size",
                     position="lower_left", font_size=9, color="#555555")
-        _add_triad(pl)
-        _place_camera(pl, camera)
-        with atomic_path(path) as tmp:
-            pl.screenshot(str(tmp))
+        _finish(pl, camera, path)
     finally:
         pl.close()
     return Path(path)
@@ -273,10 +278,7 @@ def render_scalar(surface: Surface, values: np.ndarray, path, title: str, camera
         pl.add_text(title, position="upper_edge", font_size=14, color="black")
         if note:
             pl.add_text(note, position="lower_left", font_size=9, color="#555555")
-        _add_triad(pl)
-        _place_camera(pl, camera)
-        with atomic_path(path) as tmp:
-            pl.screenshot(str(tmp))
+        _finish(pl, camera, path)
     finally:
         pl.close()
     return Path(path)
