@@ -473,7 +473,10 @@ def _run_locked(spec, out_dir, tasks, client, scheduler, workers, retry_failed, 
             info = lazy.info
     except KeyboardInterrupt as exc:
         planned = dict.fromkeys(keys)
-        raise SweepInterrupted(sum(k in done for k in planned), len(planned), out_dir,
+        # what the store holds is what a resume skips: the interrupt can land between a
+        # record's append and its entry in ``done`` (the count was one short then)
+        recorded = store.read()
+        raise SweepInterrupted(sum(k in recorded for k in planned), len(planned), out_dir,
                                exc) from None
     records = [refresh_outputs(done[k], spec.outputs, out_dir) for k in dict.fromkeys(keys)]
     records.sort(key=lambda r: (r.get("round", 0), r["point"]))
